@@ -1,0 +1,21 @@
+//! `modal-mesh`: tetrahedral meshes in, checked tetrahedral meshes out.
+//!
+//! Inputs: Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`,
+//! Medit `.mesh`, or a generator (box, cylinder, tube, sphere, bowl).
+//! Output: a [`TetMesh`] in metres whose tets are positively oriented, with
+//! unused nodes dropped and connected parts counted; plus its boundary
+//! [`Surface`] (used by the mode bank and the synthesizer).
+//!
+//! Conventions, stated once for the whole project:
+//! - Corner order: a tet `[a, b, c, d]` is positively oriented when
+//!   `(b − a) × (c − a) · (d − a) > 0` (six times its signed volume).
+//! - 10-node tets use the VTK edge order, see [`TET10_EDGES`]: node `4 + e`
+//!   sits on edge `TET10_EDGES[e]`. Gmsh stores the last two edge nodes the
+//!   other way round; its reader swaps them.
+
+mod types;
+pub use types::*;
+
+pub mod generate;
+mod promote;
+pub use promote::{to_linear, to_quadratic};

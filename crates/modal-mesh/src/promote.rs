@@ -1,0 +1,71 @@
+//! Order elevation: 4-node tets → 10-node tets with straight edges.
+
+use std::collections::HashMap;
+
+use crate::{Cells, TetMesh, TET10_EDGES};
+
+/// Returns the mesh with 10-node tets. A 4-node mesh gains one node at the
+/// midpoint of every edge, shared by all tets around that edge (so the
+/// quadratic field stays conforming); a 10-node mesh is returned unchanged,
+/// keeping its own (possibly curved) mid-edge nodes.
+pub fn to_quadratic(mesh: &TetMesh) -> TetMesh {
+    let Cells::Tet4(tets) = &mesh.cells else {
+        return mesh.clone();
+    };
+    let mut nodes = mesh.nodes.clone();
+    let mut midpoint_of: HashMap<(usize, usize), usize> = HashMap::new();
+    let quadratic = tets
+        .iter()
+        .map(|tet| {
+            let mut t10 = [0usize; 10];
+            t10[..4].copy_from_slice(tet);
+            for (e, [a, b]) in TET10_EDGES.iter().enumerate() {
+                let (p, q) = (tet[*a], tet[*b]);
+                let key = (p.min(q), p.max(q));
+                t10[4 + e] = *midpoint_of.entry(key).or_insert_with(|| {
+                    let (x, y) = (nodes[p], nodes[q]);
+                    nodes.push([(x[0] + y[0]) / 2.0, (x[1] + y[1]) / 2.0, (x[2] + y[2]) / 2.0]);
+                    nodes.len() - 1
+                });
+            }
+            t10
+        })
+        .collect();
+    TetMesh { nodes, cells: Cells::Tet10(quadratic), groups: mesh.groups.clone() }
+}
+
+/// Returns the mesh with 4-node tets: a 10-node mesh keeps only its corner
+/// nodes (mid-edge nodes that no longer belong to any tet are dropped and
+/// the rest renumbered); a 4-node mesh is returned unchanged.
+pub fn to_linear(mesh: &TetMesh) -> TetMesh {
+    let Cells::Tet10(tets) = &mesh.cells else {
+        return mesh.clone();
+    };
+    // Keep corner nodes in their original relative order.
+    let mut is_corner = vec![false; mesh.nodes.len()];
+    tets.iter().flat_map(|t| &t[..4]).for_each(|&n| is_corner[n] = true);
+    let mut new_index = vec![usize::MAX; mesh.nodes.len()];
+    let mut nodes = Vec::new();
+    for (n, _) in is_corner.iter().enumerate().filter(|(_, &c)| c) {
+        new_index[n] = nodes.len();
+        nodes.push(mesh.nodes[n]);
+    }
+    let linear = tets.iter().map(|t| [t[0], t[1], t[2], t[3]].map(|n| new_index[n])).collect();
+    TetMesh { nodes, cells: Cells::Tet4(linear), groups: mesh.groups.clone() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::box_mesh;
+
+    #[test]
+    fn promotion_shares_edge_nodes_and_round_trips() {
+        let linear = box_mesh([1.0, 1.0, 1.0], [2, 2, 2]);
+        let quadratic = to_quadratic(&linear);
+        // A grid of 3x3x3 nodes split into Kuhn tets has these unique edges:
+        // axis edges 3*2*3*3 = 54, face diagonals 3*2*2*3 = 36, body diagonals 8.
+        assert_eq!(quadratic.nodes.len(), 27 + 54 + 36 + 8);
+        assert_eq!(to_linear(&quadratic), linear);
+    }
+}
