@@ -1,0 +1,1 @@
+//! `modal-precompute`: mesh → FEM → eigen → mode bank, through the cache.

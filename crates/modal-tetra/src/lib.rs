@@ -1,0 +1,1 @@
+//! `modal-tetra`: surface meshes (OBJ/STL/PLY) in, quality tet meshes out.
