@@ -13,8 +13,15 @@
 //!   sits on edge `TET10_EDGES[e]`. Gmsh stores the last two edge nodes the
 //!   other way round; its reader swaps them.
 
+mod error;
 mod types;
+pub use error::{Location, MeshError};
 pub use types::*;
+
+pub mod io;
+mod validate;
+pub use io::{read_mesh, write_msh41, write_msh41_file};
+pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO};
 
 pub mod generate;
 mod promote;
