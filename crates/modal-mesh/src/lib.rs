@@ -19,8 +19,10 @@ pub use error::{Location, MeshError};
 pub use types::*;
 
 pub mod io;
+mod surface;
 mod validate;
 pub use io::{read_mesh, write_msh41, write_msh41_file};
+pub use surface::boundary_surface;
 pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO};
 
 pub mod generate;

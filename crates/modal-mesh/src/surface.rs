@@ -1,0 +1,103 @@
+//! Boundary surface of a tet mesh: the faces that belong to exactly one tet.
+//!
+//! For a positively oriented tet `[0, 1, 2, 3]` the faces
+//! `[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]` (opposite corners 0..3) have
+//! counter-clockwise corners seen from outside, i.e. the normal
+//! `(b − a) × (c − a)` points out of the tet; boundary faces keep that
+//! orientation, so the surface normals point out of the body.
+
+use std::collections::HashMap;
+
+use crate::validate::{cross, dot, sub};
+use crate::{Cells, Surface, TetMesh, TET10_EDGES};
+
+/// Outward faces of a positive tet, as local corner indices.
+const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// Local index (4..10) of the mid-edge node between corners `a` and `b`.
+fn edge_slot(a: usize, b: usize) -> usize {
+    let e = TET10_EDGES.iter().position(|&[p, q]| (p == a && q == b) || (p == b && q == a));
+    4 + e.expect("corners of a tet edge")
+}
+
+/// The boundary surface of `mesh` (faces used by exactly one tet), outward
+/// oriented if the tets are positively oriented (run [`crate::check`] first),
+/// with local node numbering in order of first use. For 10-node meshes the
+/// mid-edge nodes of each triangle's edges (0,1), (1,2), (2,0) are included.
+/// Faces are listed in tet order, then face order, so the result is
+/// deterministic. Node indices must be in range.
+pub fn boundary_surface(mesh: &TetMesh) -> Surface {
+    let mut count: HashMap<[usize; 3], u32> = HashMap::with_capacity(2 * mesh.cells.len());
+    for e in 0..mesh.cells.len() {
+        let c = mesh.cells.corners(e);
+        for f in TET_FACES {
+            let mut key = f.map(|k| c[k]);
+            key.sort_unstable();
+            *count.entry(key).or_default() += 1;
+        }
+    }
+    let quadratic = matches!(mesh.cells, Cells::Tet10(_));
+    let mut local: HashMap<usize, usize> = HashMap::new();
+    let mut surface = Surface::default();
+    let mut edge_nodes = Vec::new();
+    let mut local_of = |node: usize, s: &mut Surface| {
+        *local.entry(node).or_insert_with(|| {
+            s.node_ids.push(node);
+            s.positions.push(mesh.nodes[node]);
+            s.node_ids.len() - 1
+        })
+    };
+    for e in 0..mesh.cells.len() {
+        let c = mesh.cells.corners(e);
+        let all = mesh.cells.nodes_of(e);
+        for f in TET_FACES {
+            let mut key = f.map(|k| c[k]);
+            key.sort_unstable();
+            if count[&key] != 1 {
+                continue;
+            }
+            let tri = f.map(|k| local_of(c[k], &mut surface));
+            surface.triangles.push(tri);
+            if quadratic {
+                let mids = [0, 1, 2].map(|i| all[edge_slot(f[i], f[(i + 1) % 3])]);
+                edge_nodes.push(mids.map(|n| local_of(n, &mut surface)));
+            }
+        }
+    }
+    if quadratic {
+        surface.triangle_edge_nodes = Some(edge_nodes);
+    }
+    surface
+}
+
+impl Surface {
+    /// Area vector `(b − a) × (c − a) / 2` of triangle `t` [m²]: the
+    /// outward normal times the (flat) triangle's area.
+    pub fn area_vector(&self, t: usize) -> [f64; 3] {
+        let [a, b, c] = self.triangles[t].map(|k| self.positions[k]);
+        cross(sub(b, a), sub(c, a)).map(|x| 0.5 * x)
+    }
+
+    /// Total area of the flat corner triangles [m²].
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len()).map(|t| dot(self.area_vector(t), self.area_vector(t)).sqrt()).sum()
+    }
+
+    /// Axis-aligned bounding box `(min, max)` of the surface nodes [m].
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        crate::io::bounding_box(&self.positions)
+    }
+
+    /// Number of surface edges used by other than exactly two triangles
+    /// (0 for a closed, manifold surface).
+    pub fn open_edge_count(&self) -> usize {
+        let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
+        for t in &self.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        uses.values().filter(|&&n| n != 2).count()
+    }
+}
