@@ -19,7 +19,9 @@ pub use error::{Location, MeshError};
 pub use types::*;
 
 pub mod io;
+mod quality;
 mod surface;
+pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 mod validate;
 pub use io::{read_mesh, write_msh41, write_msh41_file};
 pub use surface::boundary_surface;
@@ -27,4 +29,4 @@ pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DE
 
 pub mod generate;
 mod promote;
-pub use promote::{to_linear, to_quadratic};
+pub use promote::{to_linear, to_quadratic, to_quadratic_with};

@@ -9,6 +9,16 @@ use crate::{Cells, TetMesh, TET10_EDGES};
 /// quadratic field stays conforming); a 10-node mesh is returned unchanged,
 /// keeping its own (possibly curved) mid-edge nodes.
 pub fn to_quadratic(mesh: &TetMesh) -> TetMesh {
+    to_quadratic_with(mesh, |a, b| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0])
+}
+
+/// Like [`to_quadratic`], but the new node of the edge between nodes at
+/// `a` and `b` is placed at `midpoint(a, b)` (generators use it to put
+/// mid-edge nodes on curved surfaces). Called once per unique edge.
+pub fn to_quadratic_with(
+    mesh: &TetMesh,
+    mut midpoint: impl FnMut([f64; 3], [f64; 3]) -> [f64; 3],
+) -> TetMesh {
     let Cells::Tet4(tets) = &mesh.cells else {
         return mesh.clone();
     };
@@ -23,8 +33,8 @@ pub fn to_quadratic(mesh: &TetMesh) -> TetMesh {
                 let (p, q) = (tet[*a], tet[*b]);
                 let key = (p.min(q), p.max(q));
                 t10[4 + e] = *midpoint_of.entry(key).or_insert_with(|| {
-                    let (x, y) = (nodes[p], nodes[q]);
-                    nodes.push([(x[0] + y[0]) / 2.0, (x[1] + y[1]) / 2.0, (x[2] + y[2]) / 2.0]);
+                    let m = midpoint(nodes[p], nodes[q]);
+                    nodes.push(m);
                     nodes.len() - 1
                 });
             }

@@ -5,7 +5,7 @@ use crate::{Cells, TetMesh};
 /// The six Kuhn (Freudenthal) tets of the unit cube around its main diagonal
 /// 0 → 7, as corner indices `i + 2j + 4k`. Every cube of the grid uses the
 /// same split, so face diagonals of neighbours match and the mesh conforms.
-const KUHN_TETS: [[usize; 4]; 6] =
+pub(crate) const KUHN_TETS: [[usize; 4]; 6] =
     [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
 
 /// A box `[0, size[0]] × [0, size[1]] × [0, size[2]]` [m] with
