@@ -1,6 +1,6 @@
 //! Reader/writer tests on the committed meshes in `meshes/` (made with
 //! `../shared/tools/make_mesh.py box OUT 0.3 0.02 0.01 --h 0.01 [--order 2]
-//! [--binary] [--v22]` and `sphere OUT 0.05 --h 0.02`, Gmsh 4.x) and on small
+//! [--binary] [--v22]` (bar_p1_v22_binary: `--v22 --binary`) and `sphere OUT 0.05 --h 0.02`, Gmsh 4.x) and on small
 //! files written by the tests. Node/tet counts were cross-checked with
 //! meshio: `meshio.read(f)` → bar: 256 points, 618 tetra; bar_p2: 1383
 //! points, 618 tetra10; sphere: 208 points, 672 tetra.
@@ -40,7 +40,7 @@ fn binary_and_v22_files_read_the_same_mesh_as_ascii() {
     // ASCII files print 16 significant digits, so coordinates agree to
     // round-off only; the connectivity must be identical.
     let ascii = load("bar_p1.msh");
-    for name in ["bar_p1_binary.msh", "bar_p1_v22.msh"] {
+    for name in ["bar_p1_binary.msh", "bar_p1_v22.msh", "bar_p1_v22_binary.msh"] {
         let other = load(name);
         assert!(other.cells == ascii.cells, "{name}: connectivity differs");
         assert_eq!(other.nodes.len(), ascii.nodes.len());

@@ -187,9 +187,9 @@ impl<'a> Cursor<'a> {
     pub fn check_count(&self, count: u64, min_bytes: usize, what: &str) -> Result<usize, MeshError> {
         let fits = (self.remaining() / min_bytes.max(1)) as u64;
         if count > fits {
-            return Err(
-                self.error(format!("{what} count {count} is larger than the rest of the file can hold"))
-            );
+            return Err(self.error(format!(
+                "{what} count {count} does not fit in the rest of the file (truncated or corrupt?)"
+            )));
         }
         Ok(count as usize)
     }
