@@ -1,1 +1,41 @@
 //! `modal-tetra`: surface meshes (OBJ/STL/PLY) in, quality tet meshes out.
+//!
+//! Inputs: a triangle surface file in metres ([`read_surface`]; `scale`
+//! multiplies, a unit warning points to `--scale`), possibly with holes,
+//! flipped or inconsistently oriented triangles, duplicate vertices,
+//! degenerate triangles, self-intersections or several parts.
+//! Output: a [`modal_mesh::TetMesh`] of positively oriented 4-node tets with
+//! no unused nodes, plus a [`TetReport`] (quality, volume, surface deviation).
+//!
+//! Pipeline ([`tetrahedralize`]):
+//! 1. [`diagnose`]: weld, drop degenerates, classify edges, orient triangles
+//!    consistently per component, outward by signed volume ([`SurfaceReport`]).
+//! 2. Inside/outside: generalized winding number ≥ ½ (Jacobson et al. 2013)
+//!    with a BVH dipole far field (module `bvh`).
+//! 3. Isosurface stuffing on a BCC lattice of cell size h (Labelle & Shewchuk
+//!    2007, module `stuff`): cut points on lattice edges at the exact surface
+//!    crossing, lattice points near the surface snapped onto it, stencils clip
+//!    lattice tets to the inside. Dihedral angles stay within [9°, 166°]
+//!    (checked by the tests on every output).
+
+mod bvh;
+mod diagnose;
+mod error;
+mod geom;
+mod lattice;
+mod mesher;
+mod read;
+pub mod shapes;
+mod stuff;
+mod surface;
+
+pub use diagnose::{diagnose, SurfaceReport};
+pub use error::TetraError;
+pub use geom::dihedral_angles_deg;
+pub use mesher::{tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL};
+pub use read::{parse_surface, read_surface, SurfaceFormat};
+pub use stuff::{ALPHA_LONG, ALPHA_SHORT};
+pub use surface::{write_obj, TriSurface};
+
+/// Bounds every output of [`tetrahedralize`] is tested against [degrees].
+pub const DIHEDRAL_BOUNDS_DEG: (f64, f64) = (9.0, 166.0);

@@ -1,0 +1,243 @@
+//! Input diagnostics and orientation repair of a triangle surface.
+//!
+//! Steps: weld vertices closer than 1e-10 × the bounding-box diagonal (count
+//! duplicates), drop triangles that collapse to zero area (count degenerates),
+//! classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
+//! or more), then orient triangles consistently across manifold edges per
+//! connected component (breadth-first) and flip a component whose signed
+//! volume is negative. The repaired triangles feed the winding number.
+
+use std::collections::HashMap;
+
+use crate::geom::{cross, dot, norm, sub, V3};
+use crate::TriSurface;
+
+/// What was wrong with an input surface (all counts refer to the input).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct SurfaceReport {
+    /// Number of input triangles.
+    pub triangles: usize,
+    /// Number of input vertices.
+    pub vertices: usize,
+    /// Part names, in file order.
+    pub parts: Vec<String>,
+    /// Bounding box minimum corner [m].
+    pub bbox_min: [f64; 3],
+    /// Bounding box maximum corner [m].
+    pub bbox_max: [f64; 3],
+    /// Bounding-box diagonal [m].
+    pub diagonal_m: f64,
+    /// Vertices merged into an earlier one at the same position.
+    pub duplicate_vertices: usize,
+    /// Triangles of zero area (or repeated corners) that were ignored.
+    pub degenerate_triangles: usize,
+    /// Edges used by exactly one triangle (holes, open sheets).
+    pub open_boundary_edges: usize,
+    /// Edges used by three or more triangles.
+    pub non_manifold_edges: usize,
+    /// Manifold edges whose two triangles traverse it the same way.
+    pub inconsistent_edges: usize,
+    /// Triangles whose orientation the repair reversed.
+    pub flipped_faces: usize,
+    /// Edge-connected components (after welding).
+    pub components: usize,
+    /// Σ |signed volume| of the oriented components [m³] (exact for closed
+    /// surfaces; overlapping parts are counted twice).
+    pub enclosed_volume_m3: f64,
+    /// Human-readable warnings, e.g. the unit hint pointing to `--scale`.
+    pub warnings: Vec<String>,
+}
+
+impl SurfaceReport {
+    /// True when the surface is a closed, consistently oriented, outward
+    /// manifold without duplicates or degenerate triangles.
+    pub fn is_clean(&self) -> bool {
+        self.duplicate_vertices == 0
+            && self.degenerate_triangles == 0
+            && self.open_boundary_edges == 0
+            && self.non_manifold_edges == 0
+            && self.inconsistent_edges == 0
+            && self.flipped_faces == 0
+    }
+}
+
+/// A welded, consistently oriented copy of a surface (degenerates removed).
+#[derive(Clone, Debug)]
+pub(crate) struct Repaired {
+    pub vertices: Vec<V3>,
+    pub triangles: Vec<[usize; 3]>,
+    pub report: SurfaceReport,
+}
+
+/// Diagnoses `surface` (see the module doc). Never fails; an empty surface
+/// gives an all-zero report.
+pub fn diagnose(surface: &TriSurface) -> SurfaceReport {
+    repair(surface).report
+}
+
+pub(crate) fn repair(surface: &TriSurface) -> Repaired {
+    let mut report = SurfaceReport {
+        triangles: surface.triangles.len(),
+        vertices: surface.vertices.len(),
+        parts: surface.parts.iter().map(|(n, _)| n.clone()).collect(),
+        ..Default::default()
+    };
+    if let Some((lo, hi)) = surface.bounding_box() {
+        report.bbox_min = lo;
+        report.bbox_max = hi;
+        report.diagonal_m = norm(sub(hi, lo));
+    }
+    let (vertices, map, duplicates) = weld(surface, report.diagonal_m * 1e-10);
+    report.duplicate_vertices = duplicates;
+    let mut triangles = Vec::with_capacity(surface.triangles.len());
+    for t in &surface.triangles {
+        let t = t.map(|v| map[v]);
+        let n = cross(sub(vertices[t[1]], vertices[t[0]]), sub(vertices[t[2]], vertices[t[0]]));
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || norm(n) == 0.0 {
+            report.degenerate_triangles += 1;
+        } else {
+            triangles.push(t);
+        }
+    }
+    let flips = orient(&vertices, &mut triangles, &mut report);
+    report.flipped_faces = flips;
+    report.warnings.extend(unit_warning(report.diagonal_m));
+    Repaired { vertices, triangles, report }
+}
+
+/// Merges vertices on a grid of spacing `tol`; returns the welded vertices,
+/// the old → new map and the number of merged vertices.
+fn weld(surface: &TriSurface, tol: f64) -> (Vec<V3>, Vec<usize>, usize) {
+    let tol = if tol > 0.0 { tol } else { f64::MIN_POSITIVE };
+    let mut index: HashMap<[i64; 3], usize> = HashMap::with_capacity(surface.vertices.len());
+    let mut used = vec![false; surface.vertices.len()];
+    for t in &surface.triangles {
+        for &v in t {
+            used[v] = true;
+        }
+    }
+    let mut vertices = Vec::new();
+    let mut duplicates = 0;
+    let map = surface
+        .vertices
+        .iter()
+        .zip(&used)
+        .map(|(p, &u)| {
+            let key = p.map(|c| (c / tol).round() as i64);
+            match index.get(&key) {
+                Some(&i) => {
+                    duplicates += usize::from(u);
+                    i
+                }
+                None => {
+                    vertices.push(*p);
+                    index.insert(key, vertices.len() - 1);
+                    vertices.len() - 1
+                }
+            }
+        })
+        .collect();
+    (vertices, map, duplicates)
+}
+
+/// Orients triangles consistently per component; returns how many were
+/// flipped. Fills the edge and component counts of `report`.
+fn orient(vertices: &[V3], triangles: &mut [[usize; 3]], report: &mut SurfaceReport) -> usize {
+    // (min vertex, max vertex, triangle, traversed min→max)
+    let mut edges: Vec<(usize, usize, usize, bool)> = Vec::with_capacity(3 * triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b), t, a < b));
+        }
+    }
+    edges.sort_unstable();
+    // Adjacency across manifold edges: (neighbour, same traversal direction).
+    let mut adjacency: Vec<Vec<(usize, bool)>> = vec![Vec::new(); triangles.len()];
+    let mut start = 0;
+    while start < edges.len() {
+        let mut end = start + 1;
+        while end < edges.len() && edges[end].0 == edges[start].0 && edges[end].1 == edges[start].1 {
+            end += 1;
+        }
+        match end - start {
+            1 => report.open_boundary_edges += 1,
+            2 => {
+                let (s, t) = (edges[start], edges[start + 1]);
+                let same = s.3 == t.3;
+                report.inconsistent_edges += usize::from(same);
+                adjacency[s.2].push((t.2, same));
+                adjacency[t.2].push((s.2, same));
+            }
+            _ => report.non_manifold_edges += 1,
+        }
+        start = end;
+    }
+    let mut flip = vec![false; triangles.len()];
+    let mut seen = vec![false; triangles.len()];
+    let mut flipped = 0;
+    for seed in 0..triangles.len() {
+        if seen[seed] {
+            continue;
+        }
+        report.components += 1;
+        seen[seed] = true;
+        let mut component = vec![seed];
+        let mut next = 0;
+        while next < component.len() {
+            let t = component[next];
+            next += 1;
+            for &(n, same) in &adjacency[t] {
+                if !seen[n] {
+                    seen[n] = true;
+                    flip[n] = flip[t] ^ same;
+                    component.push(n);
+                }
+            }
+        }
+        let volume = signed_volume(vertices, triangles, &component, &flip);
+        let reverse = volume < 0.0;
+        report.enclosed_volume_m3 += volume.abs();
+        for &t in &component {
+            flip[t] ^= reverse;
+            if flip[t] {
+                triangles[t].swap(1, 2);
+                flipped += 1;
+            }
+        }
+    }
+    flipped
+}
+
+/// Signed volume of a component under the given flips, about its first vertex.
+fn signed_volume(vertices: &[V3], triangles: &[[usize; 3]], component: &[usize], flip: &[bool]) -> f64 {
+    let origin = vertices[triangles[component[0]][0]];
+    component
+        .iter()
+        .map(|&t| {
+            let [a, b, c] = triangles[t].map(|v| sub(vertices[v], origin));
+            let v = dot(a, cross(b, c)) / 6.0;
+            if flip[t] {
+                -v
+            } else {
+                v
+            }
+        })
+        .sum()
+}
+
+/// A warning when the size suggests the file is not in metres.
+fn unit_warning(diagonal: f64) -> Option<String> {
+    if diagonal > 20.0 {
+        Some(format!(
+            "the bounding box diagonal is {diagonal:.4} m: if the file is in millimetres use --scale 0.001, in centimetres --scale 0.01"
+        ))
+    } else if diagonal > 0.0 && diagonal < 0.005 {
+        Some(format!(
+            "the bounding box diagonal is only {:.4} mm: check the file's units and use --scale if it is not in metres",
+            diagonal * 1e3
+        ))
+    } else {
+        None
+    }
+}

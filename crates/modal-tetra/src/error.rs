@@ -1,0 +1,90 @@
+//! Typed errors of the surface readers and the tetrahedralizer.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong between a surface file and a tet mesh.
+/// Each message is one line naming the offending file, item or option.
+#[derive(Debug, thiserror::Error)]
+pub enum TetraError {
+    /// The file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// File that failed.
+        path: PathBuf,
+        /// Underlying I/O error.
+        source: std::io::Error,
+    },
+    /// The extension is not one of obj, stl, ply.
+    #[error("{path}: unsupported surface format (expected .obj, .stl or .ply)")]
+    UnsupportedFormat {
+        /// File with the unknown extension.
+        path: PathBuf,
+    },
+    /// The third-party parser rejected the file (garbage, truncated, ...).
+    #[error("{format} parse error: {message}")]
+    Parse {
+        /// "OBJ", "STL" or "PLY".
+        format: &'static str,
+        /// Parser message.
+        message: String,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// Offending vertex index (0-based, file order).
+        vertex: usize,
+    },
+    /// A triangle references a vertex that does not exist.
+    #[error("triangle {triangle} references vertex {vertex}, but there are only {count} vertices")]
+    IndexOutOfRange {
+        /// Offending triangle (0-based).
+        triangle: usize,
+        /// Referenced vertex.
+        vertex: usize,
+        /// Number of vertices.
+        count: usize,
+    },
+    /// A PLY face is not a polygon with at least three corners.
+    #[error("face {face} has {corners} corners (need at least 3)")]
+    BadFace {
+        /// Offending face (0-based).
+        face: usize,
+        /// Its corner count.
+        corners: usize,
+    },
+    /// The file (or the chosen part) holds no triangle.
+    #[error("the surface has no triangles")]
+    Empty,
+    /// `part` names an object the file does not contain.
+    #[error("no part named {requested:?}; the file has: {available}")]
+    UnknownPart {
+        /// Requested name.
+        requested: String,
+        /// Comma-separated list of the names present.
+        available: String,
+    },
+    /// A bad option value (scale, cell size, ...).
+    #[error("invalid option {name}: {reason}")]
+    InvalidOption {
+        /// Option name, e.g. `scale` or `cell`.
+        name: &'static str,
+        /// Why it was rejected.
+        reason: String,
+    },
+    /// The requested resolution would exceed `TetOptions::max_tets`.
+    #[error("cell size {cell_m:.3e} m would make about {estimated} tets, above the limit of {limit} (raise --cell or the limit)")]
+    TooManyTets {
+        /// Cell size that was asked for or derived [m].
+        cell_m: f64,
+        /// Estimated number of tets.
+        estimated: u64,
+        /// The configured limit.
+        limit: usize,
+    },
+    /// The surface encloses no volume at the chosen resolution.
+    #[error("no tets: the surface encloses no volume thicker than the cell size {cell_m:.3e} m (is it an open sheet, or is --cell too coarse?)")]
+    NoVolume {
+        /// Cell size used [m].
+        cell_m: f64,
+    },
+}
