@@ -1,7 +1,5 @@
 //! Order elevation: 4-node tets → 10-node tets with straight edges.
 
-use std::collections::HashMap;
-
 use crate::{Cells, TetMesh, TET10_EDGES};
 
 /// Returns the mesh with 10-node tets. A 4-node mesh gains one node at the
@@ -22,21 +20,37 @@ pub fn to_quadratic_with(
     let Cells::Tet4(tets) = &mesh.cells else {
         return mesh.clone();
     };
+    // Sort all (edge, slot) pairs so each unique edge gets one new node,
+    // numbered in order of the edge's first appearance (tet order).
+    let mut edges: Vec<((usize, usize), usize)> = Vec::with_capacity(6 * tets.len());
+    for (t, tet) in tets.iter().enumerate() {
+        for (e, [a, b]) in TET10_EDGES.iter().enumerate() {
+            let (p, q) = (tet[*a], tet[*b]);
+            edges.push(((p.min(q), p.max(q)), 6 * t + e));
+        }
+    }
+    edges.sort_unstable();
+    let mut first_slot = vec![0usize; edges.len()];
+    for run in edges.chunk_by(|x, y| x.0 == y.0) {
+        let first = run[0].1; // smallest slot: sorted by (edge, slot)
+        run.iter().for_each(|&(_, slot)| first_slot[slot] = first);
+    }
     let mut nodes = mesh.nodes.clone();
-    let mut midpoint_of: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut node_of_slot = vec![usize::MAX; edges.len()];
     let quadratic = tets
         .iter()
-        .map(|tet| {
+        .enumerate()
+        .map(|(t, tet)| {
             let mut t10 = [0usize; 10];
             t10[..4].copy_from_slice(tet);
             for (e, [a, b]) in TET10_EDGES.iter().enumerate() {
-                let (p, q) = (tet[*a], tet[*b]);
-                let key = (p.min(q), p.max(q));
-                t10[4 + e] = *midpoint_of.entry(key).or_insert_with(|| {
-                    let m = midpoint(nodes[p], nodes[q]);
+                let first = first_slot[6 * t + e];
+                if node_of_slot[first] == usize::MAX {
+                    let m = midpoint(nodes[tet[*a]], nodes[tet[*b]]);
                     nodes.push(m);
-                    nodes.len() - 1
-                });
+                    node_of_slot[first] = nodes.len() - 1;
+                }
+                t10[4 + e] = node_of_slot[first];
             }
             t10
         })

@@ -27,39 +27,47 @@ fn edge_slot(a: usize, b: usize) -> usize {
 /// Faces are listed in tet order, then face order, so the result is
 /// deterministic. Node indices must be in range.
 pub fn boundary_surface(mesh: &TetMesh) -> Surface {
-    let mut count: HashMap<[usize; 3], u32> = HashMap::with_capacity(2 * mesh.cells.len());
-    for e in 0..mesh.cells.len() {
+    let n_tets = mesh.cells.len();
+    // Sort all faces by their corner set; a face seen once is on the boundary.
+    let mut faces: Vec<([usize; 3], usize)> = Vec::with_capacity(4 * n_tets);
+    for e in 0..n_tets {
         let c = mesh.cells.corners(e);
-        for f in TET_FACES {
-            let mut key = f.map(|k| c[k]);
+        for (f, face) in TET_FACES.iter().enumerate() {
+            let mut key = face.map(|k| c[k]);
             key.sort_unstable();
-            *count.entry(key).or_default() += 1;
+            faces.push((key, 4 * e + f));
+        }
+    }
+    faces.sort_unstable();
+    let mut on_boundary = vec![false; 4 * n_tets];
+    for run in faces.chunk_by(|a, b| a.0 == b.0) {
+        if let [(_, id)] = run {
+            on_boundary[*id] = true;
         }
     }
     let quadratic = matches!(mesh.cells, Cells::Tet10(_));
-    let mut local: HashMap<usize, usize> = HashMap::new();
+    let mut local = vec![usize::MAX; mesh.nodes.len()];
     let mut surface = Surface::default();
     let mut edge_nodes = Vec::new();
     let mut local_of = |node: usize, s: &mut Surface| {
-        *local.entry(node).or_insert_with(|| {
+        if local[node] == usize::MAX {
+            local[node] = s.node_ids.len();
             s.node_ids.push(node);
             s.positions.push(mesh.nodes[node]);
-            s.node_ids.len() - 1
-        })
+        }
+        local[node]
     };
-    for e in 0..mesh.cells.len() {
+    for e in 0..n_tets {
         let c = mesh.cells.corners(e);
         let all = mesh.cells.nodes_of(e);
-        for f in TET_FACES {
-            let mut key = f.map(|k| c[k]);
-            key.sort_unstable();
-            if count[&key] != 1 {
+        for (f, face) in TET_FACES.iter().enumerate() {
+            if !on_boundary[4 * e + f] {
                 continue;
             }
-            let tri = f.map(|k| local_of(c[k], &mut surface));
-            surface.triangles.push(tri);
+            let triangle = face.map(|k| local_of(c[k], &mut surface));
+            surface.triangles.push(triangle);
             if quadratic {
-                let mids = [0, 1, 2].map(|i| all[edge_slot(f[i], f[(i + 1) % 3])]);
+                let mids = [0, 1, 2].map(|i| all[edge_slot(face[i], face[(i + 1) % 3])]);
                 edge_nodes.push(mids.map(|n| local_of(n, &mut surface)));
             }
         }
