@@ -106,9 +106,9 @@ pub enum MeshError {
     DegenerateTet {
         /// Element index.
         element: usize,
-        /// Its signed volume [m³].
+        /// Its signed volume (m³).
         volume: f64,
-        /// The threshold it fell below [m³].
+        /// The threshold it fell below (m³).
         tolerance: f64,
     },
     /// A 10-node tet is inverted somewhere inside (curved too much).

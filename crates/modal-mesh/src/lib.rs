@@ -1,32 +1,44 @@
 //! `modal-mesh`: tetrahedral meshes in, checked tetrahedral meshes out.
 //!
-//! Inputs: Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`,
-//! Medit `.mesh`, or a generator (box, cylinder, tube, sphere, bowl).
-//! Output: a [`TetMesh`] in metres whose tets are positively oriented, with
-//! unused nodes dropped and connected parts counted; plus its boundary
-//! [`Surface`] (used by the mode bank and the synthesizer).
+//! Inputs: Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII/binary), TetGen
+//! `.node`/`.ele`, Medit `.mesh` ([`read_mesh`], module [`io`]), or a
+//! generator (box, cylinder, tube, sphere, bowl; [`generate::generate`]).
+//! [`check`] turns a raw mesh into one the FEM can trust: positively
+//! oriented tets, no degenerate or inverted elements, unused nodes dropped,
+//! connected parts counted ([`MeshReport`]). [`boundary_surface`] extracts
+//! the outward boundary [`Surface`] (used by the mode bank and the
+//! synthesizer); [`to_quadratic`] / [`to_linear`] change the element order;
+//! [`write_msh41`] writes Gmsh MSH 4.1 that Gmsh and meshio open.
 //!
 //! Conventions, stated once for the whole project:
+//! - Units: metres; readers multiply file coordinates by a caller's scale.
 //! - Corner order: a tet `[a, b, c, d]` is positively oriented when
 //!   `(b − a) × (c − a) · (d − a) > 0` (six times its signed volume).
 //! - 10-node tets use the VTK edge order, see [`TET10_EDGES`]: node `4 + e`
 //!   sits on edge `TET10_EDGES[e]`. Gmsh stores the last two edge nodes the
-//!   other way round; its reader swaps them.
+//!   other way round; its reader and writer swap them.
+//! - Reference tet: `(ξ, η, ζ)` with barycentrics `L0 = 1 − ξ − η − ζ`,
+//!   `L1 = ξ`, `L2 = η`, `L3 = ζ` (see [`tet10_shape_gradients`]).
+//!
+//! Errors are [`MeshError`] values whose message is one line naming the
+//! file position, element or node; nothing here panics on user data.
 
 mod error;
-mod types;
-pub use error::{Location, MeshError};
-pub use types::*;
-
-pub mod io;
+mod measure;
+mod promote;
 mod quality;
 mod surface;
-pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
+mod types;
 mod validate;
-pub use io::{read_mesh, write_msh41, write_msh41_file};
-pub use surface::boundary_surface;
-pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO};
 
 pub mod generate;
-mod promote;
+pub mod io;
+
+pub use error::{Location, MeshError};
+pub use io::{read_mesh, write_msh41, write_msh41_file};
+pub use measure::{mesh_volume, tet_volume};
 pub use promote::{to_linear, to_quadratic, to_quadratic_with};
+pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
+pub use surface::boundary_surface;
+pub use types::*;
+pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO};

@@ -9,7 +9,7 @@
 use crate::validate::{dot, sub};
 use crate::{TetMesh, TET10_EDGES};
 
-/// The six dihedral angles [degrees] of the tet with corners `p`, in
+/// The six dihedral angles (degrees) of the tet with corners `p`, in
 /// [`TET10_EDGES`] order.
 pub fn dihedral_angles_deg(p: [[f64; 3]; 4]) -> [f64; 6] {
     TET10_EDGES.map(|[i, j]| {
@@ -27,7 +27,7 @@ pub fn dihedral_angles_deg(p: [[f64; 3]; 4]) -> [f64; 6] {
     })
 }
 
-/// Smallest dihedral angle [degrees] over all (corner) tets of the mesh;
+/// Smallest dihedral angle (degrees) over all (corner) tets of the mesh;
 /// 180 for an empty mesh. Node indices must be in range.
 pub fn min_dihedral_angle_deg(mesh: &TetMesh) -> f64 {
     (0..mesh.cells.len())

@@ -79,19 +79,19 @@ pub fn boundary_surface(mesh: &TetMesh) -> Surface {
 }
 
 impl Surface {
-    /// Area vector `(b − a) × (c − a) / 2` of triangle `t` [m²]: the
+    /// Area vector `(b − a) × (c − a) / 2` of triangle `t` (m²): the
     /// outward normal times the (flat) triangle's area.
     pub fn area_vector(&self, t: usize) -> [f64; 3] {
         let [a, b, c] = self.triangles[t].map(|k| self.positions[k]);
         cross(sub(b, a), sub(c, a)).map(|x| 0.5 * x)
     }
 
-    /// Total area of the flat corner triangles [m²].
+    /// Total area of the flat corner triangles (m²).
     pub fn area(&self) -> f64 {
         (0..self.triangles.len()).map(|t| dot(self.area_vector(t), self.area_vector(t)).sqrt()).sum()
     }
 
-    /// Axis-aligned bounding box `(min, max)` of the surface nodes [m].
+    /// Axis-aligned bounding box `(min, max)` of the surface nodes (m).
     pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
         crate::io::bounding_box(&self.positions)
     }

@@ -66,7 +66,7 @@ pub struct PhysicalGroup {
 /// A tetrahedral mesh in SI units (metres).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TetMesh {
-    /// Node coordinates [m]. DOF `3 i + c` of the FEM belongs to node `i`.
+    /// Node coordinates (m). DOF `3 i + c` of the FEM belongs to node `i`.
     pub nodes: Vec<[f64; 3]>,
     /// Tets.
     pub cells: Cells,
@@ -97,7 +97,7 @@ impl TetMesh {
 pub struct Surface {
     /// Mesh node index of each surface node.
     pub node_ids: Vec<usize>,
-    /// Surface node positions [m] (`nodes[node_ids[k]]`).
+    /// Surface node positions (m) (`nodes[node_ids[k]]`).
     pub positions: Vec<[f64; 3]>,
     /// Corner triangles, local surface-node indices, outward orientation.
     pub triangles: Vec<[usize; 3]>,

@@ -43,11 +43,11 @@ pub struct MeshReport {
     pub unused_nodes_dropped: usize,
     /// Connected parts (each contributes six rigid-body modes).
     pub parts: usize,
-    /// Total volume [m³] (straight-sided corner tets).
+    /// Total volume (m³) (straight-sided corner tets).
     pub volume: f64,
-    /// Smallest and largest corner-tet volume [m³].
+    /// Smallest and largest corner-tet volume (m³).
     pub min_tet_volume: f64,
-    /// Largest corner-tet volume [m³].
+    /// Largest corner-tet volume (m³).
     pub max_tet_volume: f64,
     /// Human-readable warnings for the CLI (one line each).
     pub warnings: Vec<String>,

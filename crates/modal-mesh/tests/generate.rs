@@ -157,3 +157,19 @@ fn bad_parameters_are_rejected() {
         assert!(matches!(err, MeshError::TooManyElements { limit: MAX_GENERATED_TETS, .. }), "{err}");
     }
 }
+
+#[test]
+fn curved_quadratic_sphere_has_nearly_the_exact_volume() {
+    // Faceted P1 loses O(h²) of the volume; curved P2 boundaries O(h⁴).
+    let r: f64 = 0.05;
+    let exact = 4.0 / 3.0 * PI * r.powi(3);
+    let p1 = modal_mesh::mesh_volume(&generate(&Shape::Sphere { radius: r }, r / 3.0, 1).unwrap());
+    let p2_mesh = generate(&Shape::Sphere { radius: r }, r / 3.0, 2).unwrap();
+    let p2 = modal_mesh::mesh_volume(&p2_mesh);
+    let straight = modal_mesh::mesh_volume(&modal_mesh::to_quadratic(&modal_mesh::to_linear(&p2_mesh)));
+    let (e1, e2) = ((exact - p1) / exact, (exact - p2).abs() / exact);
+    assert!((straight - p1).abs() < 1e-12 * exact, "straight P2 volume must equal P1");
+    assert!(e1 > 0.01, "P1 error {e1}");
+    // Measured 2026-11-22 at h = R/3: P1 3.28e-2, curved P2 1.99e-4.
+    assert!(e2 < 0.01 * e1, "P2 error {e2} vs P1 error {e1}");
+}

@@ -8,7 +8,7 @@ use crate::{Cells, TetMesh};
 pub(crate) const KUHN_TETS: [[usize; 4]; 6] =
     [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
 
-/// A box `[0, size[0]] × [0, size[1]] × [0, size[2]]` [m] with
+/// A box `[0, size[0]] × [0, size[1]] × [0, size[2]]` (m) with
 /// `cells[c]` hexahedra along axis `c`, each split into six 4-node tets,
 /// all positively oriented.
 ///

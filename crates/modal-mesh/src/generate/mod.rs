@@ -3,7 +3,7 @@
 //! hemispherical bowl. All tets are positively oriented and conforming.
 //!
 //! [`generate`] is the single entry point for the CLI: it validates the
-//! parameters, picks cell counts from the target element size `h` [m] and
+//! parameters, picks cell counts from the target element size `h` (m) and
 //! returns a 4-node (`order` 1) or 10-node (`order` 2) mesh. Quadratic
 //! meshes of curved shapes have their mid-edge nodes on the true surface.
 
@@ -23,41 +23,41 @@ use mapped::positive;
 pub enum Shape {
     /// Box `[0, size[0]] × [0, size[1]] × [0, size[2]]`.
     Box {
-        /// Edge lengths [m].
+        /// Edge lengths (m).
         size: [f64; 3],
     },
     /// Solid cylinder along z from z = 0, axis through the origin.
     Cylinder {
-        /// Radius [m].
+        /// Radius (m).
         radius: f64,
-        /// Length along z [m].
+        /// Length along z (m).
         length: f64,
     },
     /// Hollow cylinder along z from z = 0.
     Tube {
-        /// Inner radius [m].
+        /// Inner radius (m).
         inner_radius: f64,
-        /// Outer radius [m] (> inner).
+        /// Outer radius (m) (> inner).
         outer_radius: f64,
-        /// Length along z [m].
+        /// Length along z (m).
         length: f64,
     },
     /// Ball centred at the origin.
     Sphere {
-        /// Radius [m].
+        /// Radius (m).
         radius: f64,
     },
     /// Hemispherical shell opening towards +z, rim in the plane z = 0,
     /// centre of curvature at the origin.
     Bowl {
-        /// Outer radius [m].
+        /// Outer radius (m).
         radius: f64,
-        /// Wall thickness [m] (< radius).
+        /// Wall thickness (m) (< radius).
         thickness: f64,
     },
 }
 
-/// Meshes `shape` with elements of size about `h` [m] at element `order`
+/// Meshes `shape` with elements of size about `h` (m) at element `order`
 /// (1: 4-node, 2: 10-node). Errors on non-finite or non-positive lengths,
 /// an inner radius not below the outer one, a thickness not below the
 /// radius, an order other than 1 or 2, or a mesh of more than

@@ -115,7 +115,7 @@ impl OGrid {
     }
 }
 
-/// Solid cylinder of `radius` and `length` [m] along z from z = 0.
+/// Solid cylinder of `radius` and `length` (m) along z from z = 0.
 pub fn cylinder(radius: f64, length: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
     positive("radius", radius)?;
     positive("length", length)?;
@@ -129,7 +129,7 @@ pub fn cylinder(radius: f64, length: f64, h: f64, order: u8) -> Result<TetMesh, 
     mesh.build(order)
 }
 
-/// Tube (hollow cylinder) with radii `inner < outer` and `length` [m]
+/// Tube (hollow cylinder) with radii `inner < outer` and `length` (m)
 /// along z from z = 0. q-space is physical space; quadratic mid-edge nodes
 /// are placed by averaging in cylindrical coordinates, so they stay on the
 /// walls.
@@ -164,7 +164,7 @@ pub fn tube(inner: f64, outer: f64, length: f64, h: f64, order: u8) -> Result<Te
     mesh.build(order)
 }
 
-/// Solid ball of `radius` [m] centred at the origin.
+/// Solid ball of `radius` (m) centred at the origin.
 pub fn sphere(radius: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
     positive("radius", radius)?;
     positive("h", h)?;
@@ -173,7 +173,7 @@ pub fn sphere(radius: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
     mesh.build(order)
 }
 
-/// Hemispherical shell of outer `radius` and `thickness` [m]: the points
+/// Hemispherical shell of outer `radius` and `thickness` (m): the points
 /// with `radius − thickness ≤ |x| ≤ radius` and `z ≤ 0` (a bowl opening
 /// upwards, its rim in the plane z = 0).
 pub fn bowl(radius: f64, thickness: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
