@@ -24,7 +24,7 @@ pub const DEFAULT_CELLS_PER_DIAGONAL: f64 = 25.0;
 /// Default: at least this many cells across the mean wall thickness 2V/A
 /// (V enclosed volume, A surface area; 2V/A is the wall thickness of a thin
 /// shell and 2/3 of the radius of a ball), so thin shells are not too coarse.
-pub const DEFAULT_CELLS_PER_THICKNESS: f64 = 2.5;
+pub const DEFAULT_CELLS_PER_THICKNESS: f64 = 1.5;
 
 /// Tetrahedralization options. Resolution: `cell` wins over `target_tets`;
 /// with neither, `cell = diagonal / cells_per_diagonal`.

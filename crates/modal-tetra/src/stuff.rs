@@ -171,7 +171,7 @@ impl Builder<'_> {
 pub(crate) fn stuff(lattice: &Lattice, bvh: &Bvh) -> Stuffed {
     let count = lattice.point_count();
     let mut pos: Vec<V3> = (0..count).map(|i| lattice.position(lattice.coord(i))).collect();
-    let mut sign: Vec<i8> = pos.par_iter().map(|&p| if bvh.winding(p) >= 0.5 { 1 } else { -1 }).collect();
+    let mut sign = signs(lattice, bvh, &pos);
     let neighbours = |v: usize| {
         let c = lattice.coord(v);
         NEIGHBOURS.iter().filter_map(move |d| lattice.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]]))
@@ -217,6 +217,82 @@ pub(crate) fn stuff(lattice: &Lattice, bvh: &Bvh) -> Stuffed {
         b.stencil(t, s);
     });
     Stuffed { nodes: b.nodes, tets: b.tets, dropped: b.dropped }
+}
+
+/// Inside (+1) / outside (−1) of every lattice point, from the winding number.
+///
+/// Blocks of cubes far from the surface are classified at once: with the
+/// block's centre c at distance d from every triangle and the block within
+/// radius ρ < d / [`BLOCK_MARGIN`] of c, w is harmonic on the ball B(c, d).
+/// For a closed surface it is then constant there (0 or 1), so one sample
+/// decides the block exactly; for open surfaces the block is accepted only
+/// when |w(c) − ½| > [`BLOCK_CLEARANCE`] (a heuristic: w varies slowly so far
+/// from the triangles). Other blocks are split in two along their longest
+/// axis, down to single cubes whose points are evaluated one by one.
+fn signs(lattice: &Lattice, bvh: &Bvh, pos: &[V3]) -> Vec<i8> {
+    let mut sign = vec![0i8; pos.len()];
+    let mut pending = Vec::new();
+    let mut blocks = vec![([0usize; 3], lattice.n)];
+    while let Some((lo, hi)) = blocks.pop() {
+        let extent: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        let centre = lattice.position(std::array::from_fn(|a| (lo[a] + hi[a]) as i64));
+        let radius =
+            0.5 * lattice.h * ((extent[0].pow(2) + extent[1].pow(2) + extent[2].pow(2)) as f64).sqrt();
+        let mut decided = None;
+        if extent.iter().all(|&e| e >= 2) && bvh.distance(centre) > BLOCK_MARGIN * radius {
+            let w = bvh.winding(centre);
+            if (w - 0.5).abs() > BLOCK_CLEARANCE {
+                decided = Some(if w >= 0.5 { 1 } else { -1 });
+            }
+        }
+        if decided.is_none() && extent.iter().any(|&e| e >= 2) {
+            let a = (0..3).max_by_key(|&a| extent[a]).unwrap_or(0);
+            let mid = lo[a] + extent[a] / 2;
+            let (mut h1, mut l2) = (hi, lo);
+            h1[a] = mid;
+            l2[a] = mid;
+            blocks.push((lo, h1));
+            blocks.push((l2, hi));
+            continue;
+        }
+        for_block_points(lattice, lo, hi, |v| match decided {
+            Some(s) => sign[v] = s,
+            None => pending.push(v),
+        });
+    }
+    let evaluated: Vec<i8> =
+        pending.par_iter().map(|&v| if bvh.winding(pos[v]) >= 0.5 { 1 } else { -1 }).collect();
+    for (&v, s) in pending.iter().zip(evaluated) {
+        sign[v] = s;
+    }
+    sign
+}
+
+/// Block acceptance: distance to the surface over block radius.
+const BLOCK_MARGIN: f64 = 1.5;
+/// Block acceptance for open surfaces: minimum |w − ½| at the block centre.
+const BLOCK_CLEARANCE: f64 = 0.3;
+
+/// Calls `f` for the lattice points owned by the block of cubes [lo, hi):
+/// the centres of its cubes and the corners with index in [lo, hi), plus
+/// the upper corners where the block touches the lattice's upper faces.
+fn for_block_points(lattice: &Lattice, lo: [usize; 3], hi: [usize; 3], mut f: impl FnMut(usize)) {
+    let top: [usize; 3] = std::array::from_fn(|a| if hi[a] == lattice.n[a] { hi[a] + 1 } else { hi[a] });
+    for k in lo[2]..top[2] {
+        for j in lo[1]..top[1] {
+            for i in lo[0]..top[0] {
+                let c = [i, j, k].map(|x| 2 * x as i64);
+                if let Some(v) = lattice.index(c) {
+                    f(v);
+                }
+                if i < hi[0] && j < hi[1] && k < hi[2] {
+                    if let Some(v) = lattice.index(c.map(|x| x + 1)) {
+                        f(v);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Where the surface crosses segment p→q; `sp` is the sign at p.

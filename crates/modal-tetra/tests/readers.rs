@@ -1,0 +1,172 @@
+//! Reader tests: OBJ/STL/PLY round trips, parts, scale and unit warnings,
+//! and hostile input that must give a typed error, never a panic.
+
+mod common;
+
+use modal_tetra::{parse_surface, read_surface, shapes, write_obj, SurfaceFormat, TetraError, TriSurface};
+
+fn obj_bytes(s: &TriSurface) -> Vec<u8> {
+    let mut out = Vec::new();
+    write_obj(s, &mut out).unwrap();
+    out
+}
+
+fn stl_ascii(s: &TriSurface) -> Vec<u8> {
+    let mut out = String::from("solid test\n");
+    for t in &s.triangles {
+        out += " facet normal 0 0 0\n  outer loop\n";
+        for &v in t {
+            let p = s.vertices[v];
+            out += &format!("   vertex {} {} {}\n", p[0], p[1], p[2]);
+        }
+        out += "  endloop\n endfacet\n";
+    }
+    out += "endsolid test\n";
+    out.into_bytes()
+}
+
+fn stl_binary(s: &TriSurface) -> Vec<u8> {
+    let mut out = vec![0u8; 80];
+    out.extend((s.triangles.len() as u32).to_le_bytes());
+    for t in &s.triangles {
+        out.extend([0u8; 12]);
+        for &v in t {
+            for c in s.vertices[v] {
+                out.extend((c as f32).to_le_bytes());
+            }
+        }
+        out.extend([0u8; 2]);
+    }
+    out
+}
+
+fn ply_ascii(s: &TriSurface) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        s.vertices.len(),
+        s.triangles.len()
+    );
+    for p in &s.vertices {
+        out += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &s.triangles {
+        out += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    out.into_bytes()
+}
+
+fn ply_binary(s: &TriSurface) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nelement face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        s.vertices.len(),
+        s.triangles.len()
+    )
+    .into_bytes();
+    for p in &s.vertices {
+        for c in p {
+            out.extend(c.to_le_bytes());
+        }
+    }
+    for t in &s.triangles {
+        out.push(3);
+        for &v in t {
+            out.extend((v as u32).to_le_bytes());
+        }
+    }
+    out
+}
+
+fn parse(bytes: &[u8], format: SurfaceFormat) -> Result<TriSurface, TetraError> {
+    parse_surface(bytes, format, 1.0, None).map(|(s, _)| s)
+}
+
+#[test]
+fn all_formats_read_the_same_sphere() {
+    let sphere = shapes::icosphere(0.05, 2);
+    let volume = modal_tetra::diagnose(&sphere).enclosed_volume_m3;
+    for (bytes, format) in [
+        (obj_bytes(&sphere), SurfaceFormat::Obj),
+        (stl_ascii(&sphere), SurfaceFormat::Stl),
+        (stl_binary(&sphere), SurfaceFormat::Stl),
+        (ply_ascii(&sphere), SurfaceFormat::Ply),
+        (ply_binary(&sphere), SurfaceFormat::Ply),
+    ] {
+        let (s, report) = parse_surface(&bytes, format, 1.0, None).unwrap();
+        assert_eq!(s.triangles.len(), 320, "{format:?}");
+        assert!(report.is_clean(), "{format:?}: {report:?}");
+        // f32 formats (binary STL, float PLY) round to ~1e-7 relative.
+        assert!((report.enclosed_volume_m3 / volume - 1.0).abs() < 1e-5, "{format:?}");
+    }
+}
+
+#[test]
+fn read_surface_from_files_and_scale_multiplies() {
+    let sphere = shapes::icosphere(50.0, 1); // "millimetres"
+    let path = common::temp_obj(&sphere);
+    let (_, raw) = read_surface(&path, 1.0, None).unwrap();
+    assert!(raw.warnings.iter().any(|w| w.contains("--scale 0.001")), "{:?}", raw.warnings);
+    let (s, scaled) = read_surface(&path, 1e-3, None).unwrap();
+    assert!(scaled.warnings.is_empty(), "{:?}", scaled.warnings);
+    assert!((s.diagonal() - raw.diagonal_m * 1e-3).abs() < 1e-12);
+    let tiny = shapes::icosphere(0.001, 1);
+    let (_, r) = parse_surface(&obj_bytes(&tiny), SurfaceFormat::Obj, 1.0, None).unwrap();
+    assert!(r.warnings.iter().any(|w| w.contains("units")), "{:?}", r.warnings);
+    assert!(matches!(read_surface("x.3ds", 1.0, None), Err(TetraError::UnsupportedFormat { .. })));
+    assert!(matches!(read_surface("/nonexistent/a.obj", 1.0, None), Err(TetraError::Io { .. })));
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            read_surface(&path, bad, None),
+            Err(TetraError::InvalidOption { name: "scale", .. })
+        ));
+    }
+}
+
+#[test]
+fn parts_are_kept_together_unless_one_is_chosen() {
+    let mug = shapes::mug(0.04, 0.1, 0.005, 24);
+    let bytes = obj_bytes(&mug);
+    let (all, report) = parse_surface(&bytes, SurfaceFormat::Obj, 1.0, None).unwrap();
+    assert_eq!(report.parts, ["cup", "handle"]);
+    assert_eq!(all.triangles.len(), mug.triangles.len());
+    let (handle, _) = parse_surface(&bytes, SurfaceFormat::Obj, 1.0, Some("handle")).unwrap();
+    assert_eq!(handle.triangles.len(), mug.parts[1].1.len());
+    match parse_surface(&bytes, SurfaceFormat::Obj, 1.0, Some("saucer")) {
+        Err(e @ TetraError::UnknownPart { .. }) => {
+            let msg = e.to_string();
+            assert!(msg.contains("saucer") && msg.contains("cup, handle"), "{msg}");
+        }
+        other => panic!("expected UnknownPart, got {other:?}"),
+    }
+}
+
+#[test]
+fn hostile_input_gives_typed_errors() {
+    let sphere = shapes::icosphere(0.05, 1);
+    let garbage: Vec<u8> = (0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
+    for format in [SurfaceFormat::Obj, SurfaceFormat::Stl, SurfaceFormat::Ply] {
+        assert!(parse(&garbage, format).is_err(), "{format:?} garbage");
+        assert!(parse(b"", format).is_err(), "{format:?} empty");
+    }
+    // Truncated binary STL and PLY; a binary STL header claiming 4 billion triangles.
+    let stl = stl_binary(&sphere);
+    assert!(parse(&stl[..stl.len() - 7], SurfaceFormat::Stl).is_err());
+    let mut lying = stl.clone();
+    lying[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+    assert!(parse(&lying, SurfaceFormat::Stl).is_err());
+    let ply = ply_binary(&sphere);
+    assert!(parse(&ply[..ply.len() - 5], SurfaceFormat::Ply).is_err());
+    let huge = b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n";
+    assert!(parse(huge, SurfaceFormat::Ply).is_err());
+    // NaN coordinate, index out of range, no triangles.
+    let nan = b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n";
+    assert!(matches!(parse(nan, SurfaceFormat::Obj), Err(TetraError::NonFiniteVertex { vertex: 2 })));
+    let oob = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+    assert!(matches!(parse(oob, SurfaceFormat::Ply), Err(TetraError::IndexOutOfRange { vertex: 7, .. })));
+    let neg = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -5\n";
+    assert!(matches!(parse(neg, SurfaceFormat::Ply), Err(TetraError::IndexOutOfRange { .. })));
+    let obj_oob = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n";
+    assert!(parse(obj_oob, SurfaceFormat::Obj).is_err());
+    assert!(matches!(parse(b"v 0 0 0\nv 1 0 0\n", SurfaceFormat::Obj), Err(TetraError::Empty)));
+    let text = String::from_utf8(stl_ascii(&sphere)).unwrap().replacen("vertex ", "vertex NaN ", 1);
+    assert!(parse(text.as_bytes(), SurfaceFormat::Stl).is_err());
+}
