@@ -45,7 +45,7 @@ pub struct MeshReport {
     pub parts: usize,
     /// Total volume (m³) (straight-sided corner tets).
     pub volume: f64,
-    /// Smallest and largest corner-tet volume (m³).
+    /// Smallest corner-tet volume (m³).
     pub min_tet_volume: f64,
     /// Largest corner-tet volume (m³).
     pub max_tet_volume: f64,

@@ -142,7 +142,7 @@ fn bad_parameters_are_rejected() {
         (Shape::Tube { inner_radius: 1.0, outer_radius: 1.0, length: 1.0 }, 0.5, 1, "inner_radius"),
         (Shape::Bowl { radius: 1.0, thickness: 1.0 }, 0.5, 1, "thickness"),
     ];
-    for (shape, h, order, name) in bad {
+    for (shape, h, order, name) in bad.iter().cloned() {
         match generate(&shape, h, order) {
             Err(MeshError::InvalidParameter { name: got, .. }) => assert_eq!(got, name, "{shape:?}"),
             other => panic!("{shape:?}: {other:?}"),
@@ -172,4 +172,21 @@ fn curved_quadratic_sphere_has_nearly_the_exact_volume() {
     assert!(e1 > 0.01, "P1 error {e1}");
     // Measured 2026-11-22 at h = R/3: P1 3.28e-2, curved P2 1.99e-4.
     assert!(e2 < 0.01 * e1, "P2 error {e2} vs P1 error {e1}");
+}
+
+#[test]
+fn curved_quadratic_volumes_match_every_shape() {
+    // Curved P2 meshes reproduce the exact volume far better than P1.
+    let shapes = [
+        (Shape::Cylinder { radius: 0.02, length: 0.05 }, 0.006),
+        (Shape::Tube { inner_radius: 0.015, outer_radius: 0.02, length: 0.03 }, 0.005),
+        (Shape::Bowl { radius: 0.1, thickness: 0.01 }, 0.015),
+    ];
+    for (shape, h) in shapes {
+        let exact = shape.volume();
+        let p1 = modal_mesh::mesh_volume(&generate(&shape, h, 1).unwrap());
+        let p2 = modal_mesh::mesh_volume(&generate(&shape, h, 2).unwrap());
+        let (e1, e2) = ((exact - p1) / exact, ((exact - p2) / exact).abs());
+        assert!(e1 > 0.0 && e2 < 0.05 * e1, "{shape:?}: P1 {e1:e}, P2 {e2:e}");
+    }
 }

@@ -57,6 +57,24 @@ pub enum Shape {
     },
 }
 
+impl Shape {
+    /// Exact volume of the shape (m³) (the meshes approach it as h → 0).
+    pub fn volume(&self) -> f64 {
+        use std::f64::consts::PI;
+        match *self {
+            Shape::Box { size } => size[0] * size[1] * size[2],
+            Shape::Cylinder { radius, length } => PI * radius * radius * length,
+            Shape::Tube { inner_radius, outer_radius, length } => {
+                PI * (outer_radius * outer_radius - inner_radius * inner_radius) * length
+            }
+            Shape::Sphere { radius } => 4.0 / 3.0 * PI * radius.powi(3),
+            Shape::Bowl { radius, thickness } => {
+                2.0 / 3.0 * PI * (radius.powi(3) - (radius - thickness).powi(3))
+            }
+        }
+    }
+}
+
 /// Meshes `shape` with elements of size about `h` (m) at element `order`
 /// (1: 4-node, 2: 10-node). Errors on non-finite or non-positive lengths,
 /// an inner radius not below the outer one, a thickness not below the

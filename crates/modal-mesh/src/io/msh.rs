@@ -7,6 +7,10 @@
 //! [`crate::TET10_EDGES`], so Gmsh nodes 8 and 9 are swapped on reading
 //! (and back on writing).
 //!
+//! A file with both 4-node and 10-node tets is rejected
+//! ([`MeshError::MixedOrders`]): promoting the linear ones silently would
+//! hide a meshing mistake. A file with no tets gives [`MeshError::NoTets`].
+//!
 //! Physical groups of dimension 3 become [`PhysicalGroup`]s, named from
 //! `$PhysicalNames` (or by their tag when unnamed). Format reference:
 //! Gmsh reference manual, section "MSH file format" (versions 4.1 and 2.2).
