@@ -17,10 +17,13 @@
 //!    crossing, lattice points near the surface snapped onto it, stencils clip
 //!    lattice tets to the inside. Dihedral angles stay within [9°, 166°]
 //!    (checked by the tests on every output).
+//! 4. Sharp features (module `features`): boundary nodes near sharp input
+//!    edges and corners are moved onto them when quality allows.
 
 mod bvh;
 mod diagnose;
 mod error;
+mod features;
 mod geom;
 mod lattice;
 mod mesher;
@@ -31,6 +34,7 @@ mod surface;
 
 pub use diagnose::{diagnose, SurfaceReport};
 pub use error::TetraError;
+pub use features::{FEATURE_ANGLE_DEG, GUARD_DEG, SNAP_FRACTION};
 pub use geom::dihedral_angles_deg;
 pub use mesher::{tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL};
 pub use read::{parse_surface, read_surface, SurfaceFormat};

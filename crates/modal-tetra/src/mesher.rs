@@ -1,13 +1,12 @@
 //! The tetrahedralizer: options, report and the pipeline
 //! repair → winding-number BVH → BCC lattice → isosurface stuffing → checks.
 
-use std::collections::HashMap;
-
 use modal_mesh::{Cells, TetMesh};
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::diagnose::repair;
+use crate::features::{features, snap};
 use crate::geom::{area_vector, dihedral_angles_deg, norm, orient6, V3};
 use crate::lattice::Lattice;
 use crate::stuff::stuff;
@@ -41,6 +40,9 @@ pub struct TetOptions {
     pub cells_per_thickness: f64,
     /// Refuse resolutions estimated to give more tets than this.
     pub max_tets: usize,
+    /// Move boundary nodes onto sharp input edges and corners (see
+    /// [`crate::FEATURE_ANGLE_DEG`]), keeping the quality bound.
+    pub preserve_features: bool,
 }
 
 impl Default for TetOptions {
@@ -51,6 +53,7 @@ impl Default for TetOptions {
             cells_per_diagonal: DEFAULT_CELLS_PER_DIAGONAL,
             cells_per_thickness: DEFAULT_CELLS_PER_THICKNESS,
             max_tets: 4_000_000,
+            preserve_features: true,
         }
     }
 }
@@ -60,8 +63,8 @@ impl TetOptions {
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
         format!(
-            "tetra=stuffing-v1;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={}",
-            self.cell, self.target_tets, self.cells_per_diagonal, self.cells_per_thickness
+            "tetra=stuffing-v1;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={}",
+            self.cell, self.target_tets, self.cells_per_diagonal, self.cells_per_thickness, self.preserve_features
         )
     }
 }
@@ -87,6 +90,8 @@ pub struct TetReport {
     pub max_surface_deviation_m: f64,
     /// Zero-volume slivers dropped by the stencils (expected 0).
     pub dropped_degenerate: usize,
+    /// Boundary nodes moved onto sharp input edges and corners.
+    pub feature_nodes_snapped: usize,
 }
 
 /// Tetrahedralizes the solid bounded by `surface` (see the crate doc).
@@ -114,12 +119,19 @@ pub fn tetrahedralize(
 
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
     let bvh = Bvh::new(tris);
-    let stuffed = stuff(&lattice, &bvh);
+    let mut stuffed = stuff(&lattice, &bvh);
     if stuffed.tets.is_empty() {
         return Err(TetraError::NoVolume { cell_m: h });
     }
+    let boundary = boundary_nodes(&stuffed.tets);
+    let feature_nodes_snapped = if options.preserve_features {
+        let (segments, corners) = features(&repaired.vertices, &repaired.triangles);
+        snap(&mut stuffed.nodes, &stuffed.tets, &boundary, &segments, &corners, h)
+    } else {
+        0
+    };
     let (min_dihedral_deg, max_dihedral_deg, volume_m3) = quality(&stuffed.nodes, &stuffed.tets);
-    let max_surface_deviation_m = deviation(&stuffed.nodes, &stuffed.tets, &bvh);
+    let max_surface_deviation_m = deviation(&stuffed.nodes, &boundary, &bvh);
     let report = TetReport {
         tets: stuffed.tets.len(),
         nodes: stuffed.nodes.len(),
@@ -130,6 +142,7 @@ pub fn tetrahedralize(
         surface_volume_m3: repaired.report.enclosed_volume_m3,
         max_surface_deviation_m,
         dropped_degenerate: stuffed.dropped,
+        feature_nodes_snapped,
     };
     let mesh = TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() };
     Ok((mesh, report))
@@ -188,25 +201,35 @@ fn quality(nodes: &[V3], tets: &[[usize; 4]]) -> (f64, f64, f64) {
         .reduce(|| (180.0, 0.0, 0.0), |x, y| (x.0.min(y.0), x.1.max(y.1), x.2 + y.2))
 }
 
-/// Largest distance from a node on the mesh boundary to the input surface.
-fn deviation(nodes: &[V3], tets: &[[usize; 4]], bvh: &Bvh) -> f64 {
-    let mut faces: HashMap<[usize; 3], u8> = HashMap::new();
+/// Nodes on faces that belong to exactly one tet, sorted.
+fn boundary_nodes(tets: &[[usize; 4]]) -> Vec<usize> {
+    let mut faces: Vec<[usize; 3]> = Vec::with_capacity(4 * tets.len());
     for t in tets {
         for skip in 0..4 {
-            let mut f = [0; 3];
-            let mut k = 0;
-            for (j, &v) in t.iter().enumerate() {
-                if j != skip {
-                    f[k] = v;
-                    k += 1;
-                }
-            }
+            let mut f = [t[(skip + 1) % 4], t[(skip + 2) % 4], t[(skip + 3) % 4]];
             f.sort_unstable();
-            *faces.entry(f).or_insert(0) += 1;
+            faces.push(f);
         }
     }
-    let mut boundary: Vec<usize> = faces.iter().filter(|(_, &n)| n == 1).flat_map(|(f, _)| *f).collect();
-    boundary.sort_unstable();
-    boundary.dedup();
+    faces.sort_unstable();
+    let mut nodes = Vec::new();
+    let mut i = 0;
+    while i < faces.len() {
+        let mut j = i + 1;
+        while j < faces.len() && faces[j] == faces[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            nodes.extend(faces[i]);
+        }
+        i = j;
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+/// Largest distance from the given nodes to the input surface [m].
+fn deviation(nodes: &[V3], boundary: &[usize], bvh: &Bvh) -> f64 {
     boundary.par_iter().map(|&v| bvh.distance(nodes[v])).reduce(|| 0.0, f64::max)
 }
