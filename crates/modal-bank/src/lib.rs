@@ -1,8 +1,26 @@
 //! `modal-bank`: the mode bank — what the offline stage hands to the runtime.
 //!
-//! Input: the elastic modes of a solid (from `modal-eigen`), its surface and
-//! material. Output: a [`ModeBank`] in memory and on disk (safetensors, see
-//! `docs/bank-format.md`).
+//! Input: the elastic modes of a solid (from `modal-eigen`), its surface,
+//! material and mass properties. Output: a validated [`ModeBank`] in memory
+//! and on disk as a plain safetensors file (spec: `docs/bank-format.md`),
+//! a content-addressed cache of banks, material/size retuning without a new
+//! eigen solve, and a ParaView (`.vtu`) export of the mode shapes.
+//!
+//! - [`ModeBank::save`] / [`ModeBank::load`] / [`ModeBank::to_bytes`] /
+//!   [`ModeBank::from_bytes`]: the file format, checksum verified on every load;
+//! - [`ModeBank::validate`]: every invariant of a bank;
+//! - [`rayleigh`], [`ModeBank::t60_s`], [`ModeBank::damped_frequency_hz`]:
+//!   the damping convention `C = αM + βK`.
 
+mod checksum;
+mod damping;
+mod error;
+mod format;
+mod fsio;
 mod types;
+mod validate;
+
+pub use damping::rayleigh;
+pub use error::BankError;
+pub use format::{FORMAT_NAME, FORMAT_VERSION};
 pub use types::*;

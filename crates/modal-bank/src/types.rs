@@ -5,7 +5,11 @@ use modal_mesh::Surface;
 use serde::{Deserialize, Serialize};
 
 /// How the modes were computed (what `modal info` reports).
+///
+/// Stored as JSON in the bank metadata key `solve_info`; fields missing from
+/// the JSON read as their defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct SolveInfo {
     /// Element order used, 1 or 2.
     pub order: u8,
@@ -24,7 +28,9 @@ pub struct SolveInfo {
     pub factor_s: f64,
     /// Seconds spent in the eigen iteration.
     pub solve_s: f64,
-    /// Hex digest of every input that determines the result (cache key).
+    /// Hex digest of every input that determines the result: the cache key
+    /// the bank is stored under (see `BankCache`). Retuned banks carry
+    /// `retuned:<hex>` instead, so they never match a fresh solve's key.
     pub input_hash: String,
 }
 
@@ -72,5 +78,27 @@ impl ModeBank {
     pub fn shape_at(&self, mode: usize, node: usize) -> [f32; 3] {
         let base = (mode * self.surface_node_count() + node) * 3;
         [self.shapes[base], self.shapes[base + 1], self.shapes[base + 2]]
+    }
+
+    /// Time for mode `i` to decay by 60 dB, `ln(1000)/d` [s]; infinite when
+    /// the decay rate `d` is 0. Panics if `i >= mode_count()`.
+    pub fn t60_s(&self, i: usize) -> f64 {
+        crate::damping::t60_s(self.decay_rates[i])
+    }
+
+    /// Damped natural frequency of mode `i`, `f √(1 − ξ²)` [Hz]; 0 when the
+    /// mode is critically damped or overdamped (ξ ≥ 1). Panics if
+    /// `i >= mode_count()`.
+    pub fn damped_frequency_hz(&self, i: usize) -> f64 {
+        crate::damping::damped_frequency_hz(self.frequencies_hz[i], self.damping_ratios[i])
+    }
+
+    /// Recomputes `damping_ratios` and `decay_rates` from the frequencies and
+    /// the material's Rayleigh α, β (see [`crate::rayleigh`]).
+    pub fn recompute_damping(&mut self) {
+        let (alpha, beta) = (self.material.alpha, self.material.beta);
+        let (ratios, rates) = self.frequencies_hz.iter().map(|&f| crate::rayleigh(alpha, beta, f)).unzip();
+        self.damping_ratios = ratios;
+        self.decay_rates = rates;
     }
 }

@@ -1,0 +1,67 @@
+//! The bank checksum (format version 1), specified in `docs/bank-format.md`.
+//!
+//! SHA-256 over, in this order, every integer a little-endian u64 and every
+//! string its UTF-8 bytes preceded by its length as such a u64:
+//! 1. the tag `modal-bank-checksum-v1`;
+//! 2. for each tensor, sorted by name (bytewise): name, dtype (`"F64"`, …),
+//!    rank, each dimension, the byte length of its data, the data bytes;
+//! 3. for each metadata entry except `checksum`, sorted by key: key, value.
+//!
+//! Covering the metadata too means a flipped digit in, say, the material's
+//! Young's modulus is caught as well as one in the tensor data.
+
+use sha2::{Digest, Sha256};
+
+/// Domain tag hashed first.
+const TAG: &str = "modal-bank-checksum-v1";
+
+/// One tensor as the checksum sees it.
+pub(crate) struct TensorBytes<'a> {
+    pub name: &'a str,
+    pub dtype: String,
+    pub shape: &'a [usize],
+    pub data: &'a [u8],
+}
+
+/// Feeds a length-prefixed byte string.
+fn put_bytes(h: &mut Sha256, bytes: &[u8]) {
+    put_u64(h, bytes.len() as u64);
+    h.update(bytes);
+}
+
+fn put_u64(h: &mut Sha256, v: u64) {
+    h.update(v.to_le_bytes());
+}
+
+/// Lowercase hex of a digest.
+pub(crate) fn to_hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The checksum (lowercase hex) of the given tensors and metadata entries;
+/// the `checksum` entry itself is skipped if present.
+pub(crate) fn checksum<'a>(
+    mut tensors: Vec<TensorBytes<'a>>,
+    metadata: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> String {
+    let mut h = Sha256::new();
+    put_bytes(&mut h, TAG.as_bytes());
+    tensors.sort_by(|a, b| a.name.cmp(b.name));
+    for t in &tensors {
+        put_bytes(&mut h, t.name.as_bytes());
+        put_bytes(&mut h, t.dtype.as_bytes());
+        put_u64(&mut h, t.shape.len() as u64);
+        for &d in t.shape {
+            put_u64(&mut h, d as u64);
+        }
+        put_bytes(&mut h, t.data);
+    }
+    let mut entries: Vec<_> =
+        metadata.into_iter().filter(|(k, _)| *k != crate::format::KEY_CHECKSUM).collect();
+    entries.sort();
+    for (k, v) in entries {
+        put_bytes(&mut h, k.as_bytes());
+        put_bytes(&mut h, v.as_bytes());
+    }
+    to_hex(&h.finalize())
+}

@@ -1,0 +1,58 @@
+//! Files: atomic writes (temporary file in the destination's directory, then
+//! rename) and bank save/load.
+//!
+//! A rename within one directory is atomic on POSIX file systems, so readers
+//! see either the old file or the complete new one, concurrent writers of the
+//! same path each publish a complete file, and a failed write leaves nothing
+//! behind (the temporary file is deleted on drop).
+
+use crate::{BankError, ModeBank};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Writes `path` atomically with `write`, which receives a buffered sink.
+pub(crate) fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), BankError> {
+    let err = |source| BankError::Write { path: path.to_path_buf(), source };
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let prefix = format!(".{}.", path.file_name().map_or("out".into(), |n| n.to_string_lossy()));
+    let tmp = tempfile::Builder::new().prefix(&prefix).suffix(".tmp").tempfile_in(&dir).map_err(err)?;
+    {
+        let mut w = BufWriter::new(tmp.as_file());
+        write(&mut w).map_err(err)?;
+        w.flush().map_err(err)?;
+    }
+    tmp.as_file().sync_all().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}
+
+/// Reads a whole regular file.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, BankError> {
+    let read_err = |source| BankError::Read { path: path.to_path_buf(), source };
+    let meta = std::fs::metadata(path).map_err(read_err)?;
+    if !meta.is_file() {
+        return Err(BankError::NotAFile { path: path.to_path_buf() });
+    }
+    std::fs::read(path).map_err(read_err)
+}
+
+impl ModeBank {
+    /// Validates and writes the bank to `path` atomically (temporary file in
+    /// the same directory, then rename; nothing is left behind on error).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), BankError> {
+        let bytes = self.to_bytes()?;
+        atomic_write(path.as_ref(), |w| w.write_all(&bytes))
+    }
+
+    /// Reads, verifies (format, version, checksum, shapes) and validates the
+    /// bank at `path`. Content errors do not repeat the path; I/O errors do.
+    pub fn load(path: impl AsRef<Path>) -> Result<ModeBank, BankError> {
+        ModeBank::from_bytes(&read_file(path.as_ref())?)
+    }
+}
