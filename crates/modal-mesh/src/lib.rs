@@ -41,4 +41,6 @@ pub use promote::{to_linear, to_quadratic, to_quadratic_with};
 pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;
 pub use types::*;
-pub use validate::{check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO};
+pub use validate::{
+    check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO, SLIVER_ANGLE_DEG,
+};

@@ -19,7 +19,9 @@
 //!    one in FE codes → error naming the element and the point;
 //! 6. unused nodes are dropped (indices renumbered, order kept) and counted;
 //! 7. connected parts (through shared nodes) are counted: each part has its
-//!    own six rigid-body modes.
+//!    own six rigid-body modes;
+//! 8. quality: the smallest dihedral angle is reported and tets with one
+//!    below 5° are counted as slivers (a warning only).
 
 use std::collections::HashMap;
 
@@ -27,6 +29,24 @@ use crate::{Cells, MeshError, TetMesh, TET10_EDGES};
 
 /// Relative volume tolerance of the degenerate-tet check (times ℓ³).
 pub const DEGENERATE_VOLUME_RATIO: f64 = 1e-10;
+
+/// Dihedral angle (degrees) below which a valid tet is counted as a sliver
+/// in [`MeshReport::slivers`] (a warning, not an error).
+pub const SLIVER_ANGLE_DEG: f64 = 5.0;
+
+/// Smallest dihedral angle and the number of tets with one below
+/// [`SLIVER_ANGLE_DEG`].
+fn dihedral_summary(mesh: &TetMesh) -> (f64, usize) {
+    let mut smallest = 180.0f64;
+    let mut slivers = 0;
+    for e in 0..mesh.cells.len() {
+        let angles = crate::dihedral_angles_deg(mesh.cells.corners(e).map(|n| mesh.nodes[n]));
+        let min = angles.iter().fold(180.0f64, |a, &b| a.min(b));
+        smallest = smallest.min(min);
+        slivers += usize::from(min < SLIVER_ANGLE_DEG);
+    }
+    (smallest, slivers)
+}
 
 /// What [`check`] found and changed.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -49,6 +69,11 @@ pub struct MeshReport {
     pub min_tet_volume: f64,
     /// Largest corner-tet volume (m³).
     pub max_tet_volume: f64,
+    /// Smallest dihedral angle of any (corner) tet, degrees.
+    pub min_dihedral_deg: f64,
+    /// Tets with a dihedral angle below [`SLIVER_ANGLE_DEG`] (valid but
+    /// poorly shaped; they stiffen the FEM and slow the eigensolver).
+    pub slivers: usize,
     /// Human-readable warnings for the CLI (one line each).
     pub warnings: Vec<String>,
 }
@@ -70,6 +95,7 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
     }
     let dropped = drop_unused_nodes(&mut mesh);
     let (parts, _) = connected_parts(&mesh);
+    let (min_dihedral_deg, slivers) = dihedral_summary(&mesh);
     let mut warnings = Vec::new();
     if reoriented > 0 {
         warnings.push(format!(
@@ -83,6 +109,12 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
     if parts > 1 {
         warnings.push(format!("the mesh has {parts} disconnected parts (6 rigid-body modes each)"));
     }
+    if slivers > 0 {
+        warnings.push(format!(
+            "{slivers} tets have a dihedral angle below {SLIVER_ANGLE_DEG} degrees (smallest {min_dihedral_deg:.2}); \
+             results may be inaccurate"
+        ));
+    }
     let report = MeshReport {
         nodes: mesh.nodes.len(),
         tets: mesh.cells.len(),
@@ -93,6 +125,8 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
         volume,
         min_tet_volume: min_v,
         max_tet_volume: max_v,
+        min_dihedral_deg,
+        slivers,
         warnings,
     };
     Ok((mesh, report))

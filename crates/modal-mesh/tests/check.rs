@@ -81,7 +81,18 @@ fn nearly_flat_but_valid_tet_passes() {
     // V / l^3 ~ 1e-7: a terrible sliver but not degenerate by our rule.
     let mut sliver = unit_tet([0, 1, 2, 3]);
     sliver.nodes[3] = [0.3, 0.3, 6e-7];
-    assert!(check(sliver).is_ok());
+    let (_, report) = check(sliver).unwrap();
+    assert_eq!(report.slivers, 1);
+    assert!(report.min_dihedral_deg < 1e-3);
+    assert!(
+        report.warnings.iter().any(|w| w.contains("dihedral angle below 5 degrees")),
+        "{:?}",
+        report.warnings
+    );
+    let (_, regular) = check(unit_tet([0, 1, 2, 3])).unwrap();
+    // The corner tet of a cube has dihedral angles 90°, 90°, 90°, 60°, 60°, 54.7°.
+    assert_eq!(regular.slivers, 0);
+    assert!((regular.min_dihedral_deg - (1.0f64 / 3.0f64.sqrt()).acos().to_degrees()).abs() < 1e-9);
 }
 
 #[test]
