@@ -51,7 +51,7 @@ impl<'a> Cursor<'a> {
         }
     }
 
-    /// Skips whitespace and `#`/`%` comment lines when `comments` is set.
+    /// Skips whitespace and whole lines that start with `comment`.
     pub fn skip_space_and_comments(&mut self, comment: u8) {
         loop {
             self.skip_whitespace();
