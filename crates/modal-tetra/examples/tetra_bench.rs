@@ -8,18 +8,22 @@ use modal_tetra::{shapes, tetrahedralize, TetOptions};
 
 fn main() {
     let big = std::env::args().any(|a| a == "--big");
-    let mut cases =
-        vec![("icosphere 3", shapes::icosphere(0.05, 3)), ("icosphere 5", shapes::icosphere(0.05, 5))];
-    cases.push(("bowl", shapes::bowl(0.08, 0.006, 40)));
-    cases.push(("mug", shapes::mug(0.04, 0.1, 0.005, 40)));
+    let fine = TetOptions { target_tets: Some(200_000), ..Default::default() };
+    let mut cases = vec![
+        ("icosphere 3", shapes::icosphere(0.05, 3), TetOptions::default()),
+        ("icosphere 5", shapes::icosphere(0.05, 5), TetOptions::default()),
+        ("icosphere 5, target 200k tets", shapes::icosphere(0.05, 5), fine),
+    ];
+    cases.push(("bowl (meshes/bowl.obj)", shapes::bowl(0.08, 0.006, 40), TetOptions::default()));
+    cases.push(("mug (meshes/mug.obj)", shapes::mug(0.04, 0.1, 0.005, 40), TetOptions::default()));
     if big {
-        cases.push(("icosphere 7", shapes::icosphere(0.05, 7)));
+        cases.push(("icosphere 7", shapes::icosphere(0.05, 7), TetOptions::default()));
     }
     println!("| input | triangles | tets | nodes | min/max dihedral (°) | time (s) |");
     println!("|---|---|---|---|---|---|");
-    for (name, surface) in cases {
+    for (name, surface, options) in cases {
         let start = Instant::now();
-        match tetrahedralize(&surface, &TetOptions::default()) {
+        match tetrahedralize(&surface, &options) {
             Ok((_, r)) => println!(
                 "| {name} | {} | {} | {} | {:.1} / {:.1} | {:.2} |",
                 surface.triangles.len(),

@@ -38,7 +38,8 @@ pub struct TetOptions {
     pub cells_per_diagonal: f64,
     /// Minimum cells across the mean thickness 2V/A in that default case.
     pub cells_per_thickness: f64,
-    /// Refuse resolutions estimated to give more tets than this.
+    /// Refuse resolutions estimated to give more tets than this (also
+    /// bounds the lattice: at most this many cubes; default 2 M).
     pub max_tets: usize,
     /// Move boundary nodes onto sharp input edges and corners (see
     /// [`crate::FEATURE_ANGLE_DEG`]), keeping the quality bound.
@@ -52,7 +53,7 @@ impl Default for TetOptions {
             target_tets: None,
             cells_per_diagonal: DEFAULT_CELLS_PER_DIAGONAL,
             cells_per_thickness: DEFAULT_CELLS_PER_THICKNESS,
-            max_tets: 4_000_000,
+            max_tets: 2_000_000,
             preserve_features: true,
         }
     }
@@ -181,7 +182,8 @@ fn cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -> Res
 fn check_size(lattice: &Lattice, volume: f64, limit: usize) -> Result<(), TetraError> {
     let h = lattice.h;
     let cubes = lattice.n.iter().map(|&n| n as f64).product::<f64>();
-    let estimated = (12.0 * volume / (h * h * h)).max(cubes / 2.0);
+    // The lattice itself (≈ 2 points per cube) must fit as well as the output.
+    let estimated = (12.0 * volume / (h * h * h)).max(cubes);
     if estimated > limit as f64 {
         return Err(TetraError::TooManyTets { cell_m: h, estimated: estimated as u64, limit });
     }
