@@ -9,16 +9,28 @@
 //! - [`ModeBank::save`] / [`ModeBank::load`] / [`ModeBank::to_bytes`] /
 //!   [`ModeBank::from_bytes`]: the file format, checksum verified on every load;
 //! - [`ModeBank::validate`]: every invariant of a bank;
+//! - [`BankCache`] and [`CacheKey`]: content-addressed storage of banks;
+//! - [`retune`]: new material (same ν) and/or size by exact scaling;
+//! - [`export_vtu`] / [`export_vtu_file`]: surface + mode shapes for ParaView;
 //! - [`rayleigh`], [`ModeBank::t60_s`], [`ModeBank::damped_frequency_hz`]:
 //!   the damping convention `C = αM + βK`.
 
+mod cache;
 mod checksum;
 mod damping;
 mod error;
 mod format;
 mod fsio;
+mod key;
+mod retune;
 mod types;
 mod validate;
+mod vtu;
+
+pub use cache::{default_dir_from, BankCache, CACHE_DIR_ENV};
+pub use key::CacheKey;
+pub use retune::{retune, RetuneSpec, RETUNED_PREFIX};
+pub use vtu::{export_vtu, export_vtu_file, mode_array_name};
 
 pub use damping::rayleigh;
 pub use error::BankError;

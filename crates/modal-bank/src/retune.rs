@@ -1,0 +1,76 @@
+//! Retune a bank to a new material and/or size without a new eigen solve.
+//!
+//! Exact for linear elasticity (`shared/reference/materials.md`). With the
+//! same Poisson's ratio ν, `K ∝ E` and `M ∝ ρ`, so for new E', ρ':
+//! `λ' = λ · (E'/E) / (ρ'/ρ)` and mass-normalized shapes `φ' = φ · √(ρ/ρ')`.
+//! For a uniform geometric scale γ (all lengths × γ): `K ∝ γ`, `M ∝ γ³`, so
+//! `ω' = ω / γ` and `φ' = φ · γ^{-3/2}`; positions and centre of mass × γ,
+//! volume × γ³, mass × γ³ · ρ'/ρ, inertia × γ⁵ · ρ'/ρ.
+//! Damping is recomputed from the new α, β at the new frequencies;
+//! relative residuals are invariant. A different ν changes the mode shapes
+//! and needs a new solve.
+
+use crate::validate::check_material;
+use crate::{BankError, CacheKey, ModeBank};
+use modal_fem::Material;
+
+/// Prefix of the `input_hash` of a retuned bank.
+pub const RETUNED_PREFIX: &str = "retuned:";
+
+/// What to change. `None` keeps the bank's material / size.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RetuneSpec {
+    /// The new material; its ν must equal the bank's.
+    pub material: Option<Material>,
+    /// Uniform geometric scale γ > 0 applied to all lengths.
+    pub scale: Option<f64>,
+}
+
+/// Largest |ν' − ν| accepted as "the same Poisson's ratio".
+const POISSON_TOL: f64 = 1e-12;
+
+/// A new bank for `spec`'s material and size (see the module docs). Its
+/// `info.input_hash` becomes `retuned:<hex>` (hash of the old hash and the
+/// spec), so it is never served as a cache hit for a fresh solve.
+pub fn retune(bank: &ModeBank, spec: RetuneSpec) -> Result<ModeBank, BankError> {
+    let old = &bank.material;
+    let new = spec.material.clone().unwrap_or_else(|| old.clone());
+    check_material(&new)?;
+    if (new.poisson - old.poisson).abs() > POISSON_TOL {
+        return Err(BankError::PoissonChanged { bank: old.poisson, requested: new.poisson });
+    }
+    let gamma = spec.scale.unwrap_or(1.0);
+    if !(gamma.is_finite() && gamma > 0.0) {
+        return Err(BankError::InvalidScale(gamma));
+    }
+    let stiffness = new.youngs_pa / old.youngs_pa;
+    let density = new.density_kg_m3 / old.density_kg_m3;
+    let freq_factor = (stiffness / density).sqrt() / gamma;
+    let shape_factor = (1.0 / density).sqrt() * gamma.powf(-1.5);
+    let (g3, g5) = (gamma.powi(3), gamma.powi(5));
+
+    let mut out = bank.clone();
+    out.frequencies_hz.iter_mut().for_each(|f| *f *= freq_factor);
+    out.shapes.iter_mut().for_each(|v| *v = (f64::from(*v) * shape_factor) as f32);
+    out.surface.positions.iter_mut().flatten().for_each(|x| *x *= gamma);
+    let m = &mut out.mass;
+    m.volume_m3 *= g3;
+    m.mass_kg *= g3 * density;
+    m.center_of_mass_m.iter_mut().for_each(|x| *x *= gamma);
+    m.inertia_kg_m2.iter_mut().flatten().for_each(|x| *x *= g5 * density);
+    out.material = new;
+    out.recompute_damping();
+    out.info.input_hash = retuned_hash(bank, &spec, gamma);
+    out.validate()?;
+    Ok(out)
+}
+
+fn retuned_hash(bank: &ModeBank, spec: &RetuneSpec, gamma: f64) -> String {
+    let material = serde_json::to_string(&spec.material).unwrap_or_default();
+    let key = CacheKey::new("modal-retune-v1")
+        .add_str("parent_input_hash", &bank.info.input_hash)
+        .add_str("material", &material)
+        .add_f64("scale", gamma)
+        .finish();
+    format!("{RETUNED_PREFIX}{key}")
+}
