@@ -21,7 +21,12 @@ pub(crate) fn atomic_write(
         _ => PathBuf::from("."),
     };
     let prefix = format!(".{}.", path.file_name().map_or("out".into(), |n| n.to_string_lossy()));
-    let tmp = tempfile::Builder::new().prefix(&prefix).suffix(".tmp").tempfile_in(&dir).map_err(err)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // Like a plain `File::create`: 0o666 minus the umask, not tempfile's 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let tmp = builder.tempfile_in(&dir).map_err(err)?;
     {
         let mut w = BufWriter::new(tmp.as_file());
         write(&mut w).map_err(err)?;

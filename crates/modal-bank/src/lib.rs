@@ -15,6 +15,8 @@
 //! - [`rayleigh`], [`ModeBank::t60_s`], [`ModeBank::damped_frequency_hz`]:
 //!   the damping convention `C = αM + βK`.
 
+#![warn(missing_docs)]
+
 mod cache;
 mod checksum;
 mod damping;

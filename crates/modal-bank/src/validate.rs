@@ -191,7 +191,9 @@ fn check_mass(m: &MassProperties) -> Result<(), BankError> {
     check_finite("center_of_mass_m", m.center_of_mass_m)?;
     check_finite("inertia_kg_m2", m.inertia_kg_m2.iter().flatten().copied())?;
     for (field, value) in [("volume_m3", m.volume_m3), ("mass_kg", m.mass_kg)] {
-        check_finite(field, [value])?;
+        if !value.is_finite() {
+            return Err(BankError::NonFinite { field: field.into(), value });
+        }
         if value < 0.0 {
             return Err(BankError::OutOfRange { field: field.into(), value, rule: "must be ≥ 0".into() });
         }

@@ -419,3 +419,46 @@ fn solve_info_json_tolerates_missing_fields() {
     assert_eq!(info.order, 2);
     assert_eq!(info.input_hash, "");
 }
+
+#[test]
+fn header_announcing_exabytes_is_rejected_without_panic() {
+    // Offsets whose end is close to u64::MAX: adding the header length must
+    // not overflow anywhere.
+    let big = 1u64 << 60;
+    let mut entries = Vec::new();
+    let mut start = 0u64;
+    for i in 0..16 {
+        let len = if i == 15 { big - 16 } else { big };
+        entries.push(format!(
+            "\"t{i}\":{{\"dtype\":\"U8\",\"shape\":[{len}],\"data_offsets\":[{start},{}]}}",
+            start + len
+        ));
+        start += len;
+    }
+    let header = format!("{{{}}}", entries.join(","));
+    let mut bytes = (header.len() as u64).to_le_bytes().to_vec();
+    bytes.extend(header.as_bytes());
+    let err = ModeBank::from_bytes(&bytes).unwrap_err();
+    assert!(matches!(err, BankError::Truncated { .. } | BankError::NotSafetensors(_)), "{err}");
+}
+
+#[test]
+fn random_multi_byte_mutations_never_panic_or_pass_silently() {
+    let bank = quadratic_bank(2);
+    let bytes = bank.to_bytes().unwrap();
+    let header_end = 8 + u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let r = common::pseudo_random(2024, 3 * 4 * 3000);
+    let pick = |v: f64, n: usize| (((v + 1.0) / 2.0) * n as f64) as usize % n;
+    // Digits and JSON punctuation are the interesting replacements in a header.
+    let alphabet = b"0123456789[]{},:\"-.eE ";
+    for trial in r.chunks_exact(12) {
+        let mut bad = bytes.clone();
+        for m in trial.chunks_exact(3) {
+            let pos = pick(m[0], header_end);
+            bad[pos] = if m[2] > 0.0 { alphabet[pick(m[1], alphabet.len())] } else { pick(m[1], 256) as u8 };
+        }
+        if let Ok(back) = ModeBank::from_bytes(&bad) {
+            assert_eq!(back, bank);
+        }
+    }
+}

@@ -8,7 +8,7 @@ use crate::checksum::{checksum, TensorBytes};
 use crate::SolveInfo;
 use modal_fem::{MassProperties, Material};
 use modal_mesh::Surface;
-use safetensors::{tensor::Metadata, Dtype, SafeTensorError, SafeTensors};
+use safetensors::{tensor::Metadata, Dtype, SafeTensors};
 use std::collections::HashMap;
 
 /// Largest header the safetensors crate accepts.
@@ -36,34 +36,39 @@ fn read_header(bytes: &[u8]) -> Result<(Metadata, &[u8]), BankError> {
     if 8 + n > actual {
         return Err(BankError::Truncated { expected: 8 + n, actual });
     }
+    check_extent(bytes, n as usize)?;
     match SafeTensors::read_metadata(bytes) {
         Ok((n, meta)) => Ok((meta, bytes.get(8 + n..).unwrap_or_default())),
-        Err(SafeTensorError::MetadataIncompleteBuffer) => Err(extent_error(bytes, n as usize)),
         Err(e) => Err(BankError::NotSafetensors(e.to_string())),
     }
 }
 
-/// Explains a file whose size differs from what its (valid) header needs.
-fn extent_error(bytes: &[u8], n: usize) -> BankError {
+/// Checks that the tensor data announced by the header (`n` bytes after the
+/// length prefix) ends exactly at the end of the file. Done here, in u128,
+/// because safetensors 0.8 overflows (panics in debug builds) on headers
+/// whose offsets end near `u64::MAX`.
+fn check_extent(bytes: &[u8], n: usize) -> Result<(), BankError> {
     let actual = bytes.len() as u64;
-    let header: Option<serde_json::Map<String, serde_json::Value>> =
-        bytes.get(8..8 + n).and_then(|h| serde_json::from_slice(h).ok());
-    let data_end = header.map(|h| {
-        h.iter()
-            .filter(|(k, _)| *k != "__metadata__")
-            .filter_map(|(_, v)| v.get("data_offsets")?.get(1)?.as_u64())
-            .max()
-            .unwrap_or(0)
-    });
-    match data_end {
-        Some(end) if 8 + n as u64 + end > actual => {
-            BankError::Truncated { expected: 8 + n as u64 + end, actual }
-        }
-        Some(end) => BankError::NotSafetensors(format!(
+    let header: serde_json::Map<String, serde_json::Value> = bytes
+        .get(8..8 + n)
+        .and_then(|h| serde_json::from_slice(h).ok())
+        .ok_or_else(|| BankError::NotSafetensors("the header is not a JSON object".into()))?;
+    let data_end = header
+        .iter()
+        .filter(|(k, _)| *k != "__metadata__")
+        .filter_map(|(_, v)| v.get("data_offsets")?.get(1)?.as_u64())
+        .max()
+        .unwrap_or(0);
+    let needed = 8 + n as u128 + u128::from(data_end);
+    if needed > u128::from(actual) {
+        Err(BankError::Truncated { expected: u64::try_from(needed).unwrap_or(u64::MAX), actual })
+    } else if needed < u128::from(actual) {
+        Err(BankError::NotSafetensors(format!(
             "{} bytes of trailing data after the last tensor",
-            actual - (8 + n as u64 + end)
-        )),
-        None => BankError::NotSafetensors("tensor data does not match the header".into()),
+            u128::from(actual) - needed
+        )))
+    } else {
+        Ok(())
     }
 }
 
