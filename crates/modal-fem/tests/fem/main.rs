@@ -3,6 +3,9 @@
 // Index loops mirror the tensor notation of the checked formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod assembly;
+mod bar;
 mod common;
 mod mass;
+mod patch;
 mod rigid_modes;
