@@ -1,1 +1,56 @@
-//! `modal-precompute`: mesh → FEM → eigen → mode bank, through the cache.
+//! `modal-precompute`: the offline pipeline, mesh → FEM → eigen → mode bank,
+//! served from a content-addressed cache when the same inputs were solved before.
+//!
+//! Input: a [`Request`] (a mesh file or an in-memory mesh, material, element
+//! order, band, constraints). Output: a [`modal_bank::ModeBank`] plus what
+//! happened on the way ([`Outcome`]: cache hit or miss, mesh report, warnings).
+//!
+//! Stages (each reported through the progress callback):
+//! 1. load — read the tet mesh, or tetrahedralize a surface mesh (OBJ/STL/PLY);
+//! 2. check — orientation, degeneracy, unused nodes, connected parts;
+//! 3. assemble — K and M at the requested order (default 2, quadratic tets);
+//! 4. solve — shift-invert block Lanczos with rigid modes deflated, inertia check;
+//! 5. bank — mode shapes restricted to the surface, damping from Rayleigh α, β.
+
+mod key;
+mod load;
+mod pipeline;
+
+pub use key::cache_key;
+pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, SurfaceMeshing};
+pub use pipeline::{assemble_matrices, precompute, Assembled, Outcome, Request, Stage};
+
+/// Version of the numerical pipeline; part of every cache key, so changing
+/// anything that alters results must bump it.
+pub const SOLVER_VERSION: &str = "modal-precompute-1";
+
+/// Everything that can stop the pipeline, each naming the stage it came from.
+#[derive(Debug, thiserror::Error)]
+pub enum PrecomputeError {
+    /// The input file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A tet mesh that cannot be used.
+    #[error(transparent)]
+    Mesh(#[from] modal_mesh::MeshError),
+    /// A surface mesh that cannot be tetrahedralized.
+    #[error(transparent)]
+    Tetra(#[from] modal_tetra::TetraError),
+    /// Finite-element assembly failed (e.g. an inverted curved element).
+    #[error(transparent)]
+    Fem(#[from] modal_fem::FemError),
+    /// The eigen solve failed.
+    #[error(transparent)]
+    Eigen(#[from] modal_eigen::EigenError),
+    /// Reading or writing a bank failed.
+    #[error(transparent)]
+    Bank(#[from] modal_bank::BankError),
+    /// Parameters that make no sense.
+    #[error("{0}")]
+    Invalid(String),
+}

@@ -1,0 +1,81 @@
+//! Stage 1–2: get a checked tet mesh from a file (tet or surface mesh) or memory.
+
+use std::path::{Path, PathBuf};
+
+use modal_mesh::TetMesh;
+
+use crate::PrecomputeError;
+
+/// Where the geometry comes from.
+#[derive(Clone, Debug)]
+pub enum MeshSource {
+    /// A tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply).
+    File(PathBuf),
+    /// A mesh built in memory (e.g. by a generator), with a text that
+    /// identifies it uniquely for the cache (e.g. the generator parameters).
+    Memory {
+        /// The mesh, coordinates in metres (before `scale`).
+        mesh: TetMesh,
+        /// Identity of the mesh for the cache key.
+        identity: String,
+    },
+}
+
+/// Options for filling a surface mesh with tets.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceMeshing {
+    /// Lattice cell size [m]; `None` picks the documented default.
+    pub cell: Option<f64>,
+    /// Object of a multi-object surface file; `None` meshes all as one body.
+    pub part: Option<String>,
+}
+
+/// A checked tet mesh and what was found on the way.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The mesh: positively oriented, unused nodes dropped, metres.
+    pub mesh: TetMesh,
+    /// Number of connected parts.
+    pub parts: usize,
+    /// Connected part of every node.
+    pub part_of_node: Vec<usize>,
+    /// Things the user should know (reoriented tets, dropped nodes, unit hints).
+    pub warnings: Vec<String>,
+}
+
+/// True for file types that hold a surface to be tetrahedralized.
+pub fn is_surface_file(path: &Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    matches!(ext.as_str(), "obj" | "stl" | "ply")
+}
+
+/// Loads, (tetrahedralizes,) scales and checks a mesh.
+pub fn load_mesh(
+    source: &MeshSource,
+    scale: f64,
+    surface: &SurfaceMeshing,
+) -> Result<LoadedMesh, PrecomputeError> {
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
+    }
+    let mut warnings = Vec::new();
+    let raw = match source {
+        MeshSource::File(path) if is_surface_file(path) => {
+            let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
+            warnings.extend(report.warnings.iter().cloned());
+            let options = modal_tetra::TetOptions { cell: surface.cell, ..Default::default() };
+            let (mesh, _) = modal_tetra::tetrahedralize(&surf, &options)?;
+            mesh
+        }
+        MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,
+        MeshSource::Memory { mesh, .. } => {
+            let mut mesh = mesh.clone();
+            mesh.nodes.iter_mut().flatten().for_each(|x| *x *= scale);
+            mesh
+        }
+    };
+    let (mesh, report) = modal_mesh::check(raw)?;
+    warnings.extend(report.warnings.iter().cloned());
+    let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
+    Ok(LoadedMesh { mesh, parts, part_of_node, warnings })
+}

@@ -1,0 +1,288 @@
+//! Stages 3–5: assemble, solve, build the bank; with the cache around them.
+
+use std::time::Instant;
+
+use faer::sparse::SparseColMat;
+use faer::Mat;
+use modal_bank::{BankCache, ModeBank, SolveInfo};
+use modal_eigen::{EigenOptions, EigenSolution};
+use modal_fem::Material;
+use modal_mesh::TetMesh;
+
+use crate::load::SurfaceMeshing;
+use crate::{cache_key, load_mesh, MeshSource, PrecomputeError};
+
+/// What to compute. `Default` gives the CLI's defaults for everything but
+/// the source and material.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// The geometry.
+    pub source: MeshSource,
+    /// Factor applied to all coordinates (e.g. 0.001 for millimetres).
+    pub scale: f64,
+    /// Options for surface meshes (OBJ/STL/PLY).
+    pub surface: SurfaceMeshing,
+    /// Material, incl. Rayleigh damping.
+    pub material: Material,
+    /// Element order: 2 (quadratic, default) or 1 (linear).
+    pub order: u8,
+    /// Lowest frequency kept [Hz].
+    pub min_freq_hz: f64,
+    /// Highest frequency kept [Hz].
+    pub max_freq_hz: f64,
+    /// Keep at most this many modes (the lowest in the band).
+    pub max_modes: usize,
+    /// Clamp every node inside `[x0, y0, z0, x1, y1, z1]` [m].
+    pub fix_box: Option<[f64; 6]>,
+    /// Worker threads for the eigen solve (`None`: all cores).
+    pub threads: Option<usize>,
+}
+
+impl Request {
+    /// A request with the CLI defaults: order 2, 20 Hz – 20 kHz, 64 modes.
+    pub fn new(source: MeshSource, material: Material) -> Self {
+        Request {
+            source,
+            scale: 1.0,
+            surface: SurfaceMeshing::default(),
+            material,
+            order: 2,
+            min_freq_hz: 20.0,
+            max_freq_hz: 20_000.0,
+            max_modes: 64,
+            fix_box: None,
+            threads: None,
+        }
+    }
+
+    fn validate(&self) -> Result<(), PrecomputeError> {
+        let invalid = |msg: String| Err(PrecomputeError::Invalid(msg));
+        if !matches!(self.order, 1 | 2) {
+            return invalid(format!("--order must be 1 or 2, got {}", self.order));
+        }
+        if !(self.min_freq_hz.is_finite() && self.min_freq_hz >= 0.0) {
+            return invalid(format!("--min-freq must be a non-negative number, got {}", self.min_freq_hz));
+        }
+        if !(self.max_freq_hz.is_finite() && self.max_freq_hz > self.min_freq_hz) {
+            return invalid(format!(
+                "--max-freq ({}) must be a finite number above --min-freq ({})",
+                self.max_freq_hz, self.min_freq_hz
+            ));
+        }
+        if self.max_modes == 0 {
+            return invalid("--modes must be at least 1".into());
+        }
+        if self.fix_box.is_some_and(|b| b.iter().any(|x| !x.is_finite())) {
+            return invalid("--fix-box must hold finite numbers".into());
+        }
+        self.material.validate().map_err(|e| PrecomputeError::Invalid(e.to_string()))
+    }
+}
+
+/// Progress of the pipeline, for the CLI's progress display.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stage {
+    /// Reading (and maybe tetrahedralizing) the mesh.
+    Load,
+    /// Assembling K and M for this many DOFs.
+    Assemble {
+        /// Degrees of freedom.
+        dofs: usize,
+    },
+    /// The eigen solver reports progress.
+    Solve(String),
+    /// Writing the bank to the cache.
+    Store,
+}
+
+/// The result of [`precompute`].
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The modes.
+    pub bank: ModeBank,
+    /// True when served from the cache without solving.
+    pub cached: bool,
+    /// Warnings for the user (mesh fixes, unit hints, zero damping, ...).
+    pub warnings: Vec<String>,
+}
+
+/// K and M of a checked mesh at the requested order.
+pub struct Assembled {
+    /// The mesh at the element order used (mid-edge nodes added for order 2).
+    pub mesh: TetMesh,
+    /// Connected parts, and the part of each node.
+    pub parts: usize,
+    /// Part id of each node of `mesh`.
+    pub part_of_node: Vec<usize>,
+    /// Stiffness matrix [N/m], full symmetric storage.
+    pub k: SparseColMat<usize, f64>,
+    /// Consistent mass matrix [kg], full symmetric storage.
+    pub m: SparseColMat<usize, f64>,
+    /// Seconds spent assembling.
+    pub assemble_s: f64,
+    /// Warnings collected while loading.
+    pub warnings: Vec<String>,
+}
+
+/// Loads the mesh and assembles K and M (what `export-matrices` writes).
+pub fn assemble_matrices(
+    request: &Request,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Assembled, PrecomputeError> {
+    request.validate()?;
+    progress(Stage::Load);
+    let loaded = load_mesh(&request.source, request.scale, &request.surface)?;
+    let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
+    // Mid-edge nodes belong to the part of their edge's corners.
+    let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
+    progress(Stage::Assemble { dofs: 3 * mesh.nodes.len() });
+    let start = Instant::now();
+    let assembly = modal_fem::assemble(&mesh, &request.material)?;
+    Ok(Assembled {
+        mesh,
+        parts: loaded.parts,
+        part_of_node,
+        k: assembly.k,
+        m: assembly.m,
+        assemble_s: start.elapsed().as_secs_f64(),
+        warnings: loaded.warnings,
+    })
+}
+
+/// Part ids for a mesh whose first nodes are those of the checked mesh and
+/// whose added nodes (mid-edge) take the part of a tet corner.
+fn extend_parts(mesh: &TetMesh, part_of_corner: &[usize]) -> Vec<usize> {
+    let mut parts = vec![usize::MAX; mesh.nodes.len()];
+    parts[..part_of_corner.len().min(mesh.nodes.len())]
+        .copy_from_slice(&part_of_corner[..part_of_corner.len().min(mesh.nodes.len())]);
+    for t in 0..mesh.cells.len() {
+        let part = parts[mesh.cells.corners(t)[0]];
+        for &n in mesh.cells.nodes_of(t) {
+            if parts[n] == usize::MAX {
+                parts[n] = part;
+            }
+        }
+    }
+    debug_assert!(parts.iter().all(|&p| p != usize::MAX), "every node belongs to a tet");
+    parts
+}
+
+/// Computes (or fetches from `cache`) the mode bank for `request`.
+pub fn precompute(
+    request: &Request,
+    cache: Option<&BankCache>,
+    force: bool,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Outcome, PrecomputeError> {
+    request.validate()?;
+    let key = cache_key(request)?;
+    let mut warnings = Vec::new();
+    if let (Some(cache), false) = (cache, force) {
+        match cache.get(&key) {
+            Ok(Some(bank)) => return Ok(Outcome { bank, cached: true, warnings }),
+            Ok(None) => {}
+            Err(err) => warnings.push(format!("ignoring a damaged cache entry ({err}); recomputing")),
+        }
+    }
+    let assembled = assemble_matrices(request, progress)?;
+    warnings.extend(assembled.warnings.iter().cloned());
+    let bank = solve_bank(request, &assembled, key.clone(), progress)?;
+    if let Some(cache) = cache {
+        progress(Stage::Store);
+        if let Err(err) = cache.put(&key, &bank) {
+            warnings.push(format!("could not store the result in the cache: {err}"));
+        }
+    }
+    Ok(Outcome { bank, cached: false, warnings })
+}
+
+/// Clamps, deflates rigid modes, solves and builds the bank.
+fn solve_bank(
+    request: &Request,
+    assembled: &Assembled,
+    input_hash: String,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<ModeBank, PrecomputeError> {
+    let nodes = &assembled.mesh.nodes;
+    let clamped = match request.fix_box {
+        Some(b) => modal_fem::fix_box(nodes, b),
+        None => vec![false; 3 * nodes.len()],
+    };
+    if clamped.iter().all(|&c| c) {
+        return Err(PrecomputeError::Invalid(
+            "--fix-box clamps every node: nothing is left to vibrate".into(),
+        ));
+    }
+    // A part with a clamped node has no rigid-body modes.
+    let mut clamped_parts: Vec<usize> =
+        (0..nodes.len()).filter(|&n| clamped[3 * n]).map(|n| assembled.part_of_node[n]).collect();
+    clamped_parts.sort_unstable();
+    clamped_parts.dedup();
+    let rigid_full =
+        modal_fem::rigid_body_fields(nodes, &assembled.part_of_node, assembled.parts, &clamped_parts);
+    let modal_fem::Restricted { k, m, dofs: dof_map } =
+        modal_fem::restrict(&assembled.k, &assembled.m, &clamped)?;
+    let rigid = restrict_rows(&rigid_full, &dof_map.free_to_full);
+    let options = EigenOptions {
+        min_freq_hz: request.min_freq_hz,
+        max_freq_hz: request.max_freq_hz,
+        max_modes: request.max_modes,
+        threads: request.threads.unwrap_or(0),
+        ..EigenOptions::default()
+    };
+    let rigid_ref = (rigid.ncols() > 0).then(|| rigid.as_ref());
+    let solution =
+        modal_eigen::solve(&k, &m, rigid_ref, &options, &mut |p| progress(Stage::Solve(format!("{p:?}"))))?;
+    Ok(build_bank(request, assembled, &dof_map, &solution, input_hash))
+}
+
+fn restrict_rows(fields: &Mat<f64>, rows: &[usize]) -> Mat<f64> {
+    Mat::from_fn(rows.len(), fields.ncols(), |i, j| fields[(rows[i], j)])
+}
+
+/// Puts the solution into a bank: shapes at surface nodes (clamped DOFs are
+/// zero), damping from the material's Rayleigh coefficients.
+fn build_bank(
+    request: &Request,
+    assembled: &Assembled,
+    dof_map: &modal_fem::DofMap,
+    solution: &EigenSolution,
+    input_hash: String,
+) -> ModeBank {
+    let surface = modal_mesh::boundary_surface(&assembled.mesh);
+    let n_modes = solution.eigenvalues.len();
+    let mut shapes = Vec::with_capacity(n_modes * surface.node_ids.len() * 3);
+    for mode in 0..n_modes {
+        for &node in &surface.node_ids {
+            for c in 0..3 {
+                let value =
+                    dof_map.full_to_free[3 * node + c].map_or(0.0, |free| solution.vectors[(free, mode)]);
+                shapes.push(value as f32);
+            }
+        }
+    }
+    let material = &request.material;
+    let omegas: Vec<f64> = solution.eigenvalues.iter().map(|&l| l.max(0.0).sqrt()).collect();
+    let stats = &solution.stats;
+    ModeBank {
+        frequencies_hz: omegas.iter().map(|w| w / (2.0 * std::f64::consts::PI)).collect(),
+        damping_ratios: omegas.iter().map(|&w| material.damping_ratio(w)).collect(),
+        decay_rates: omegas.iter().map(|&w| material.decay_rate(w)).collect(),
+        residuals: solution.residuals.clone(),
+        shapes,
+        surface,
+        material: material.clone(),
+        mass: modal_fem::mass_properties(&assembled.mesh, material.density_kg_m3),
+        info: SolveInfo {
+            order: request.order,
+            dofs: dof_map.free_count(),
+            rigid_modes_removed: stats.rigid_modes_removed,
+            inertia_expected: stats.inertia_expected,
+            inertia_found: stats.inertia_found,
+            assemble_s: assembled.assemble_s,
+            factor_s: stats.factor_s,
+            solve_s: stats.solve_s,
+            input_hash,
+        },
+    }
+}

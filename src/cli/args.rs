@@ -1,0 +1,395 @@
+//! The command-line contract. Subcommand and flag names written in the issues
+//! are relied on by outside checks: add, never rename.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// Turn a 3D object into its sound: tetrahedral FEM modes, rigid-body impacts, WAV.
+///
+/// With no subcommand, renders the built-in demo scene to audio_out/demo.wav.
+#[derive(Debug, Parser)]
+#[command(name = "modal", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Generate a tet mesh (box, cylinder, tube, sphere, bowl) or tetrahedralize a surface mesh.
+    Mesh(MeshArgs),
+    /// Write K.mtx, M.mtx (MatrixMarket, lower triangle) and nodes.csv for a mesh.
+    ExportMatrices(ExportMatricesArgs),
+    /// Compute the audible modes of a mesh and store them in a mode bank.
+    Precompute(PrecomputeArgs),
+    /// Show what a mode bank holds.
+    Info(InfoArgs),
+    /// Change a bank's material (same Poisson's ratio) or size without a new eigen solve.
+    Retune(RetuneArgs),
+    /// Export a bank's surface and mode shapes for viewing (ParaView .vtu).
+    Export(ExportArgs),
+    /// Strike a bank at surface points and write the sound as WAV.
+    Strike(StrikeArgs),
+    /// Simulate a rigid-body scene and render its sound (no scene: the built-in demo).
+    Render(RenderArgs),
+}
+
+/// Material selection shared by every command that builds matrices.
+#[derive(Debug, Args, Clone, Default)]
+pub struct MaterialArgs {
+    /// Material preset (steel, glass, wood, plastic, iron, ceramic, polycarbonate, tin, aluminium, brass).
+    #[arg(long)]
+    pub material: Option<String>,
+    /// Young's modulus E [Pa] (overrides the preset's).
+    #[arg(long, value_name = "PA")]
+    pub youngs: Option<f64>,
+    /// Poisson's ratio ν (overrides the preset's).
+    #[arg(long, value_name = "NU")]
+    pub poisson: Option<f64>,
+    /// Density ρ [kg/m³] (overrides the preset's).
+    #[arg(long, value_name = "KG_M3")]
+    pub density: Option<f64>,
+    /// Rayleigh mass-proportional damping α [1/s] in C = αM + βK.
+    #[arg(long, value_name = "A")]
+    pub alpha: Option<f64>,
+    /// Rayleigh stiffness-proportional damping β [s] in C = αM + βK.
+    #[arg(long, value_name = "B")]
+    pub beta: Option<f64>,
+}
+
+/// Options that turn an input file into the tet mesh the FEM sees.
+#[derive(Debug, Args, Clone)]
+pub struct MeshInputArgs {
+    /// Element order: 2 = quadratic 10-node tets (default), 1 = linear 4-node tets.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub order: u8,
+    /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub scale: f64,
+    /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY).
+    #[arg(long, value_name = "H")]
+    pub cell: Option<f64>,
+    /// Object of a multi-object surface file to mesh (default: all, as one body).
+    #[arg(long, value_name = "NAME")]
+    pub part: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct MeshArgs {
+    #[command(subcommand)]
+    pub shape: MeshShape,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum MeshShape {
+    /// Box [0,X]×[0,Y]×[0,Z] of structured tets.
+    Box {
+        /// Edge lengths X,Y,Z [m].
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+        size: [f64; 3],
+        #[command(flatten)]
+        common: GenerateArgs,
+    },
+    /// Solid cylinder along z.
+    Cylinder {
+        /// Radius [m].
+        #[arg(long)]
+        radius: f64,
+        /// Length [m].
+        #[arg(long)]
+        length: f64,
+        #[command(flatten)]
+        common: GenerateArgs,
+    },
+    /// Tube (hollow cylinder) along z.
+    Tube {
+        /// Inner radius [m].
+        #[arg(long)]
+        inner_radius: f64,
+        /// Outer radius [m].
+        #[arg(long)]
+        outer_radius: f64,
+        /// Length [m].
+        #[arg(long)]
+        length: f64,
+        #[command(flatten)]
+        common: GenerateArgs,
+    },
+    /// Solid sphere centred at the origin.
+    Sphere {
+        /// Radius [m].
+        #[arg(long)]
+        radius: f64,
+        #[command(flatten)]
+        common: GenerateArgs,
+    },
+    /// Hemispherical shell (a bowl), opening upwards.
+    Bowl {
+        /// Outer radius [m].
+        #[arg(long)]
+        radius: f64,
+        /// Wall thickness [m].
+        #[arg(long)]
+        thickness: f64,
+        #[command(flatten)]
+        common: GenerateArgs,
+    },
+    /// Tetrahedralize a surface mesh (OBJ, STL, PLY).
+    Tet {
+        /// Surface mesh to fill with tets.
+        input: PathBuf,
+        /// Output .msh file (Gmsh 4.1).
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Lattice cell size [m].
+        #[arg(long, value_name = "H")]
+        cell: Option<f64>,
+        /// Multiply all coordinates by S.
+        #[arg(long, value_name = "S", default_value_t = 1.0)]
+        scale: f64,
+        /// Object of a multi-object file to mesh.
+        #[arg(long)]
+        part: Option<String>,
+        /// Print a JSON report on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Target element size [m] (default: a fifth of the smallest dimension).
+    #[arg(long, value_name = "H")]
+    pub h: Option<f64>,
+    /// Element order of the written mesh (2 puts curved mid-edge nodes on curved surfaces).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub order: u8,
+    /// Output .msh file (Gmsh 4.1 ASCII).
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportMatricesArgs {
+    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply).
+    pub mesh: PathBuf,
+    /// Output directory (created).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub material: MaterialArgs,
+    #[command(flatten)]
+    pub input: MeshInputArgs,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct PrecomputeArgs {
+    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply).
+    pub mesh: PathBuf,
+    /// Output mode bank (safetensors).
+    #[arg(short, long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub material: MaterialArgs,
+    #[command(flatten)]
+    pub input: MeshInputArgs,
+    /// Keep at most N modes (the lowest in the band).
+    #[arg(long, value_name = "N", default_value_t = 64)]
+    pub modes: usize,
+    /// Lowest frequency kept [Hz].
+    #[arg(long, value_name = "HZ", default_value_t = 20.0)]
+    pub min_freq: f64,
+    /// Highest frequency kept [Hz] (no upper cap: ultrasonic bands are legal).
+    #[arg(long, value_name = "HZ", default_value_t = 20_000.0)]
+    pub max_freq: f64,
+    /// Clamp every node inside the box X0,Y0,Z0,X1,Y1,Z1 [m].
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box)]
+    pub fix_box: Option<[f64; 6]>,
+    /// Recompute even when the cache holds the result.
+    #[arg(long)]
+    pub force: bool,
+    /// Cache directory (default $MODAL_CACHE_DIR, $XDG_CACHE_HOME/modal or ~/.cache/modal).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// Do not read or write the cache.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Mode bank file.
+    pub bank: PathBuf,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct RetuneArgs {
+    /// Mode bank to retune.
+    pub bank: PathBuf,
+    #[command(flatten)]
+    pub material: MaterialArgs,
+    /// Scale every length by S (frequencies scale by 1/S).
+    #[arg(long, value_name = "S")]
+    pub scale: Option<f64>,
+    /// Output mode bank.
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Mode bank.
+    pub bank: PathBuf,
+    /// VTK XML unstructured grid to write (ParaView).
+    #[arg(long, value_name = "OUT.vtu")]
+    pub vtk: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct StrikeArgs {
+    /// Mode bank.
+    pub bank: PathBuf,
+    /// Struck point X,Y,Z [m] (snapped to the nearest surface point); repeat for several strikes.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, required = true)]
+    pub at: Vec<[f64; 3]>,
+    /// Impulse direction X,Y,Z (default: into the surface); one, or one per --at.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub dir: Vec<[f64; 3]>,
+    /// Impulse magnitude [N·s]; one, or one per --at.
+    #[arg(long, value_name = "NS")]
+    pub impulse: Vec<f64>,
+    /// Strike time [s]; one, or one per --at.
+    #[arg(long, value_name = "S")]
+    pub time: Vec<f64>,
+    /// Contact time τ [s] of the half-sine force.
+    #[arg(long, value_name = "S", conflicts_with = "hertz")]
+    pub contact_time: Option<f64>,
+    /// Hertz contact of a sphere of MASS_KG and RADIUS_M striking at 1 m/s.
+    #[arg(long, value_name = "MASS_KG,RADIUS_M", value_parser = parse_pair)]
+    pub hertz: Option<[f64; 2]>,
+    /// Contact microphone position X,Y,Z [m] (default: the first struck point).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub mic: Option<[f64; 3]>,
+    /// Duration [s] (default: until the sound decayed by 60 dB).
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Sample rate [Hz].
+    #[arg(long, value_name = "HZ", default_value_t = 48_000)]
+    pub rate: u32,
+    /// Write 32-bit float samples (unclipped) instead of 16-bit PCM.
+    #[arg(long)]
+    pub float: bool,
+    /// Scale the output so its peak is at -1 dBFS.
+    #[arg(long)]
+    pub normalize: bool,
+    /// Output WAV file.
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args, Default)]
+pub struct RenderArgs {
+    /// Scene file (TOML); omitted: the built-in demo scene.
+    pub scene: Option<PathBuf>,
+    /// Output WAV (default: the scene's `output`, or audio_out/demo.wav for the demo).
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+    /// Also write the impact events as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub events: Option<PathBuf>,
+    /// Also write a spectrogram PNG.
+    #[arg(long, value_name = "FILE")]
+    pub spectrogram: Option<PathBuf>,
+    /// Write 32-bit float samples.
+    #[arg(long)]
+    pub float: bool,
+    /// Cache directory for mode banks.
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// Print one JSON report on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+}
+
+/// Output format of a WAV file.
+#[derive(Debug, Clone, Copy, ValueEnum, PartialEq, Eq)]
+pub enum SampleFormat {
+    Pcm16,
+    Float32,
+}
+
+fn parse_floats<const N: usize>(text: &str) -> Result<[f64; N], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != N {
+        return Err(format!("expected {N} comma-separated numbers, got '{text}'"));
+    }
+    let mut values = [0.0; N];
+    for (value, part) in values.iter_mut().zip(&parts) {
+        *value = part.parse::<f64>().map_err(|_| format!("'{part}' is not a number"))?;
+        if !value.is_finite() {
+            return Err(format!("'{part}' is not a finite number"));
+        }
+    }
+    Ok(values)
+}
+
+fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
+    parse_floats::<3>(text)
+}
+
+fn parse_pair(text: &str) -> Result<[f64; 2], String> {
+    parse_floats::<2>(text)
+}
+
+fn parse_box(text: &str) -> Result<[f64; 6], String> {
+    let b = parse_floats::<6>(text)?;
+    if (0..3).any(|c| b[c] > b[c + 3]) {
+        return Err("the box's first corner must be below the second in every coordinate".into());
+    }
+    Ok(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_parse_and_reject_garbage() {
+        assert_eq!(parse_vec3("1, 2,3e-1").unwrap(), [1.0, 2.0, 0.3]);
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,2,nan").is_err());
+        assert!(parse_box("0,0,0,1,1,1").is_ok());
+        assert!(parse_box("1,0,0,0,1,1").is_err());
+    }
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

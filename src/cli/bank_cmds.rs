@@ -1,0 +1,84 @@
+//! `modal info`, `modal retune`, `modal export`: commands on an existing bank.
+
+use anyhow::{Context, Result};
+use modal_bank::{ModeBank, RetuneSpec};
+
+use super::args::{ExportArgs, InfoArgs, RetuneArgs};
+use super::bank_report::BankJson;
+use super::output::print_json;
+use super::write_atomic;
+
+/// Loads a bank, naming the file in the error.
+pub fn load_bank(path: &std::path::Path) -> Result<ModeBank> {
+    ModeBank::load(path).with_context(|| format!("cannot load bank {}", path.display()))
+}
+
+fn show(bank: &ModeBank, json: bool) -> Result<()> {
+    let report = BankJson::new(bank, false);
+    if json {
+        print_json(&report)
+    } else {
+        report.write_table(&mut std::io::stdout().lock())?;
+        Ok(())
+    }
+}
+
+pub fn info(args: InfoArgs) -> Result<()> {
+    show(&load_bank(&args.bank)?, args.json)
+}
+
+pub fn retune(args: RetuneArgs) -> Result<()> {
+    let bank = load_bank(&args.bank)?;
+    let material_given = args.material.material.is_some()
+        || args.material.youngs.is_some()
+        || args.material.density.is_some()
+        || args.material.poisson.is_some()
+        || args.material.alpha.is_some()
+        || args.material.beta.is_some();
+    anyhow::ensure!(
+        material_given || args.scale.is_some(),
+        "nothing to retune: give --material NAME, --youngs/--density, and/or --scale S"
+    );
+    let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
+    let new = modal_bank::retune(&bank, RetuneSpec { material, scale: args.scale })?;
+    new.save(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    show(&new, args.json)?;
+    if !args.json {
+        println!("wrote {}", args.out.display());
+    }
+    Ok(())
+}
+
+/// The new material: a preset, or the bank's own with the given values replaced.
+fn retuned_material(bank: &ModeBank, args: &RetuneArgs) -> Result<modal_fem::Material> {
+    let m = &args.material;
+    let mut material = match &m.material {
+        Some(name) => modal_fem::Material::preset(name)?,
+        None => modal_fem::Material { name: None, ..bank.material.clone() },
+    };
+    material.youngs_pa = m.youngs.unwrap_or(material.youngs_pa);
+    material.poisson = m.poisson.unwrap_or(material.poisson);
+    material.density_kg_m3 = m.density.unwrap_or(material.density_kg_m3);
+    material.alpha = m.alpha.unwrap_or(material.alpha);
+    material.beta = m.beta.unwrap_or(material.beta);
+    material.validate()?;
+    Ok(material)
+}
+
+pub fn export(args: ExportArgs) -> Result<()> {
+    let bank = load_bank(&args.bank)?;
+    write_atomic(&args.vtk, |tmp| {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        modal_bank::export_vtu(&bank, &mut file)?;
+        std::io::Write::flush(&mut file)?;
+        Ok(())
+    })
+    .with_context(|| format!("cannot write {}", args.vtk.display()))?;
+    println!(
+        "wrote {} ({} modes on {} surface nodes)",
+        args.vtk.display(),
+        bank.mode_count(),
+        bank.surface_node_count()
+    );
+    Ok(())
+}

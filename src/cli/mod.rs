@@ -1,0 +1,59 @@
+//! Command-line interface: one module per subcommand. Results go to stdout
+//! (or JSON with `--json`), progress and warnings to stderr, errors as one
+//! line `error: …` with a non-zero exit code.
+
+mod args;
+mod bank_cmds;
+mod bank_report;
+mod material;
+mod mesh;
+mod output;
+mod precompute;
+mod progress;
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+pub use args::{Cli, Command};
+
+/// Parses the command line, runs the command and maps the outcome to an exit code.
+pub fn run() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
+        Err(err) => {
+            output::print_error(&err);
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        None => anyhow::bail!("the demo scene is not wired up yet"),
+        Some(Command::Precompute(args)) => precompute::run(args),
+        Some(Command::ExportMatrices(args)) => precompute::export_matrices(args),
+        Some(Command::Info(args)) => bank_cmds::info(args),
+        Some(Command::Retune(args)) => bank_cmds::retune(args),
+        Some(Command::Export(args)) => bank_cmds::export(args),
+        Some(Command::Mesh(args)) => mesh::run(args.shape),
+        Some(_) => anyhow::bail!("not implemented yet"),
+    }
+}
+
+/// Writes a file atomically: `write` fills a temporary file next to `path`,
+/// which is then renamed over `path`. On any error the temporary file is
+/// removed, so a failed or interrupted command never leaves a partial output.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,0 +1,36 @@
+//! Shared output helpers: error lines, warnings, JSON, progress.
+
+/// Prints an error and its cause chain as one line on stderr.
+pub fn print_error(err: &anyhow::Error) {
+    let mut line = format!("error: {err}");
+    for cause in err.chain().skip(1) {
+        let text = cause.to_string();
+        // Contexts often repeat their cause; print each distinct part once.
+        if !line.contains(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+    }
+    eprintln!("{}", line.replace('\n', " "));
+}
+
+/// Prints a warning on stderr (never on stdout, which may hold JSON).
+pub fn warn(message: &str) {
+    eprintln!("warning: {message}");
+}
+
+/// True when the error is a closed stdout (e.g. `modal info … | head`).
+pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|cause| {
+        cause.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// Prints `value` as one JSON document on stdout.
+pub fn print_json(value: &impl serde::Serialize) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    serde_json::to_writer_pretty(&mut out, value)?;
+    writeln!(out)?;
+    Ok(())
+}

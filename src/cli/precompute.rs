@@ -1,0 +1,115 @@
+//! `modal precompute` and `modal export-matrices`.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use modal_bank::BankCache;
+use modal_precompute::{MeshSource, Request, Stage, SurfaceMeshing};
+
+use super::args::{ExportMatricesArgs, MaterialArgs, MeshInputArgs, PrecomputeArgs};
+use super::bank_report::BankJson;
+use super::output::{print_json, warn};
+use super::progress::Spinner;
+use super::{material, write_atomic};
+
+/// Builds a pipeline request from the shared mesh and material flags.
+fn request(mesh: &Path, material_args: &MaterialArgs, input: &MeshInputArgs) -> Result<Request> {
+    let (material, warnings) = material::resolve(material_args)?;
+    warnings.iter().for_each(|w| warn(w));
+    let mut request = Request::new(MeshSource::File(mesh.to_path_buf()), material);
+    request.scale = input.scale;
+    request.order = input.order;
+    request.surface = SurfaceMeshing { cell: input.cell, part: input.part.clone() };
+    Ok(request)
+}
+
+fn describe(stage: &Stage) -> String {
+    match stage {
+        Stage::Load => "reading and checking the mesh".into(),
+        Stage::Assemble { dofs } => format!("assembling K and M ({dofs} DOF)"),
+        Stage::Solve(what) => format!("eigen solve: {what}"),
+        Stage::Store => "storing the bank in the cache".into(),
+    }
+}
+
+/// The cache the flags ask for (none with `--no-cache`).
+pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Option<BankCache> {
+    if disabled {
+        return None;
+    }
+    let dir = dir.map(Path::to_path_buf).or_else(|| BankCache::default_dir().ok())?;
+    Some(BankCache::new(dir))
+}
+
+pub fn run(args: PrecomputeArgs) -> Result<()> {
+    let mut request = request(&args.mesh, &args.material, &args.input)?;
+    request.max_modes = args.modes;
+    request.min_freq_hz = args.min_freq;
+    request.max_freq_hz = args.max_freq;
+    request.fix_box = args.fix_box;
+    request.threads = args.threads;
+    let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
+    let spinner = Spinner::new("starting");
+    let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| {
+        spinner.set(describe(&s))
+    });
+    spinner.finish();
+    let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;
+    outcome.warnings.iter().for_each(|w| warn(w));
+    outcome.bank.save(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    let report = BankJson::new(&outcome.bank, outcome.cached);
+    if args.json {
+        print_json(&report)
+    } else {
+        report.write_table(&mut std::io::stdout().lock())?;
+        println!("wrote {}", args.out.display());
+        Ok(())
+    }
+}
+
+pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
+    let request = request(&args.mesh, &args.material, &args.input)?;
+    let spinner = Spinner::new("starting");
+    let assembled = modal_precompute::assemble_matrices(&request, &mut |s| spinner.set(describe(&s)));
+    spinner.finish();
+    let assembled = assembled.with_context(|| format!("export-matrices {}", args.mesh.display()))?;
+    assembled.warnings.iter().for_each(|w| warn(w));
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
+    let write = |name: &str, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| -> Result<()> {
+        let path = args.out.join(name);
+        write_atomic(&path, |tmp| {
+            let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+            f(&mut file)?;
+            std::io::Write::flush(&mut file)?;
+            Ok(())
+        })
+        .with_context(|| format!("cannot write {}", path.display()))
+    };
+    write("K.mtx", &|w| modal_fem::write_matrix_market(&assembled.k, w))?;
+    write("M.mtx", &|w| modal_fem::write_matrix_market(&assembled.m, w))?;
+    write("nodes.csv", &|w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))?;
+    let summary = serde_json::json!({
+        "dir": args.out.display().to_string(),
+        "nodes": assembled.mesh.nodes.len(),
+        "dofs": 3 * assembled.mesh.nodes.len(),
+        "tets": assembled.mesh.cells.len(),
+        "order": assembled.mesh.order(),
+        "parts": assembled.parts,
+        "nnz_k": assembled.k.compute_nnz(),
+        "assemble_s": assembled.assemble_s,
+    });
+    if args.json {
+        print_json(&summary)
+    } else {
+        println!(
+            "wrote K.mtx, M.mtx, nodes.csv to {} ({} nodes, {} DOF, {} tets, order {})",
+            args.out.display(),
+            assembled.mesh.nodes.len(),
+            3 * assembled.mesh.nodes.len(),
+            assembled.mesh.cells.len(),
+            assembled.mesh.order()
+        );
+        Ok(())
+    }
+}
