@@ -462,3 +462,19 @@ fn random_multi_byte_mutations_never_panic_or_pass_silently() {
         }
     }
 }
+
+#[test]
+fn measured_non_rayleigh_damping_is_legal_if_consistent() {
+    let mut bank = linear_bank(3);
+    bank.damping_ratios = vec![0.01, 0.002, 0.03];
+    bank.decay_rates = bank
+        .frequencies_hz
+        .iter()
+        .zip(&bank.damping_ratios)
+        .map(|(f, xi)| xi * 2.0 * std::f64::consts::PI * f)
+        .collect();
+    assert_eq!(ModeBank::from_bytes(&bank.to_bytes().unwrap()).unwrap(), bank);
+    bank.decay_rates[2] *= 1.0 + 1e-6;
+    let err = bank.validate().unwrap_err();
+    assert!(err.to_string().starts_with("inconsistent bank: decay_rates[2]"), "{err}");
+}
