@@ -1,0 +1,304 @@
+//! Sparse factorizations of the shifted matrix `A(σ) = K − σM`.
+//!
+//! The union pattern of the upper triangles of K and M and the symbolic factorization
+//! (ordering, elimination tree, supernodes) are computed once; every shift σ only refills
+//! values and runs a numeric factorization:
+//! - `LLᵀ` (Cholesky) when σ is below the spectrum (A positive definite);
+//! - `LDLᵀ` (no pivoting) for an indefinite A. By Sylvester's law of inertia the number of
+//!   negative entries of D equals the number of eigenvalues of `K w = λ M w` below σ.
+
+use crate::ordering::{metis_node_ordering, Permutation};
+use crate::types::{EigenError, OrderingUsed};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
+use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, supernodal::SupernodalLdltRef, CholeskySymbolicParams, LdltRef, LltRef,
+    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{MatMut, Par, Side};
+
+/// Upper-triangular union pattern of K and M with maps from K and M entries to its slots.
+struct ShiftedPattern {
+    symbolic: SymbolicSparseColMat<usize>,
+    /// (slot, index into K values)
+    k_map: Vec<(usize, usize)>,
+    /// (slot, index into M values)
+    m_map: Vec<(usize, usize)>,
+}
+
+impl ShiftedPattern {
+    fn new(k: SparseColMatRef<'_, usize, f64>, m: SparseColMatRef<'_, usize, f64>) -> Self {
+        let n = k.ncols();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut k_map = Vec::new();
+        let mut m_map = Vec::new();
+        col_ptr.push(0usize);
+        let mut entries: Vec<(usize, bool, usize)> = Vec::new();
+        for j in 0..n {
+            entries.clear();
+            let kr = k.symbolic().row_idx_of_col_raw(j);
+            let kstart = k.symbolic().col_range(j).start;
+            for (o, &r) in kr.iter().enumerate() {
+                if r <= j {
+                    entries.push((r, true, kstart + o));
+                }
+            }
+            let mr = m.symbolic().row_idx_of_col_raw(j);
+            let mstart = m.symbolic().col_range(j).start;
+            for (o, &r) in mr.iter().enumerate() {
+                if r <= j {
+                    entries.push((r, false, mstart + o));
+                }
+            }
+            // The diagonal is always present so the factorization has a pivot slot.
+            entries.push((j, true, usize::MAX));
+            entries.sort_unstable_by_key(|e| e.0);
+            let mut last = usize::MAX;
+            for &(r, is_k, idx) in entries.iter() {
+                if r != last {
+                    row_idx.push(r);
+                    last = r;
+                }
+                let slot = row_idx.len() - 1;
+                if idx != usize::MAX {
+                    if is_k {
+                        k_map.push((slot, idx));
+                    } else {
+                        m_map.push((slot, idx));
+                    }
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        // SAFETY-free: new_checked validates sorted, in-range, non-duplicate row indices.
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        Self { symbolic, k_map, m_map }
+    }
+
+    /// Values of K − σM in this pattern.
+    fn values(&self, k: &[f64], m: &[f64], sigma: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(self.symbolic.row_idx().len(), 0.0);
+        for &(s, i) in &self.k_map {
+            out[s] += k[i];
+        }
+        for &(s, i) in &self.m_map {
+            out[s] -= sigma * m[i];
+        }
+    }
+}
+
+/// Kind of numeric factor held.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Kind {
+    Llt,
+    Ldlt,
+}
+
+/// Symbolic analysis plus (at most) one numeric factor of `K − σM`.
+pub struct ShiftedFactor<'a> {
+    k: SparseColMatRef<'a, usize, f64>,
+    m: SparseColMatRef<'a, usize, f64>,
+    pattern: ShiftedPattern,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    a_values: Vec<f64>,
+    kind: Option<Kind>,
+    shift: f64,
+    par: Par,
+    /// Ordering that was used.
+    pub ordering: OrderingUsed,
+}
+
+impl<'a> ShiftedFactor<'a> {
+    /// Ordering and symbolic factorization. `use_metis` requests METIS (falls back to AMD).
+    pub fn analyze(
+        k: SparseColMatRef<'a, usize, f64>,
+        m: SparseColMatRef<'a, usize, f64>,
+        use_metis: bool,
+        par: Par,
+    ) -> Result<Self, EigenError> {
+        let pattern = ShiftedPattern::new(k, m);
+        let perm: Option<Permutation> =
+            if use_metis { metis_node_ordering(pattern.symbolic.as_ref()) } else { None };
+        let fail = |e: faer::sparse::FaerError| EigenError::Factorization(format!("{e:?}"));
+        let (symbolic, ordering) = match &perm {
+            Some(p) => {
+                let pr = PermRef::new_checked(&p.fwd, &p.inv, p.fwd.len());
+                let s = factorize_symbolic_cholesky(
+                    pattern.symbolic.as_ref(),
+                    Side::Upper,
+                    SymmetricOrdering::Custom(pr),
+                    CholeskySymbolicParams::default(),
+                )
+                .map_err(fail)?;
+                (s, OrderingUsed::Metis)
+            }
+            None => {
+                let s = factorize_symbolic_cholesky(
+                    pattern.symbolic.as_ref(),
+                    Side::Upper,
+                    SymmetricOrdering::Amd,
+                    CholeskySymbolicParams::default(),
+                )
+                .map_err(fail)?;
+                (s, OrderingUsed::Amd)
+            }
+        };
+        Ok(Self {
+            k,
+            m,
+            pattern,
+            symbolic,
+            values: Vec::new(),
+            a_values: Vec::new(),
+            kind: None,
+            shift: f64::NAN,
+            par,
+            ordering,
+        })
+    }
+
+    /// Number of stored entries of the factor.
+    pub fn factor_nnz(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// Estimated peak bytes of one numeric factorization (factor values + scratch + A copy).
+    pub fn memory_estimate(&self) -> u64 {
+        let scratch =
+            self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).size_bytes();
+        let a = self.pattern.symbolic.row_idx().len() * 8 * 2;
+        (self.factor_nnz() * 8 + scratch + a) as u64
+    }
+
+    /// Shift of the current factor.
+    pub fn shift(&self) -> f64 {
+        self.shift
+    }
+
+    fn fill(&mut self, sigma: f64) -> Result<(), EigenError> {
+        let mut a = std::mem::take(&mut self.a_values);
+        self.pattern.values(self.k.val(), self.m.val(), sigma, &mut a);
+        self.a_values = a;
+        let len = self.symbolic.len_val();
+        self.values.clear();
+        self.values
+            .try_reserve_exact(len)
+            .map_err(|_| EigenError::Factorization("out of memory for the factor".into()))?;
+        self.values.resize(len, 0.0);
+        Ok(())
+    }
+
+    fn buffer(&self, req: StackReq) -> Result<MemBuffer, EigenError> {
+        MemBuffer::try_new(req)
+            .map_err(|_| EigenError::Factorization("out of memory for the workspace".into()))
+    }
+
+    /// Cholesky `K − σM = LLᵀ`; fails with `NotPositiveDefinite` if σ is not below the spectrum.
+    pub fn factor_llt(&mut self, sigma: f64) -> Result<(), EigenError> {
+        self.kind = None;
+        self.fill(sigma)?;
+        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(self.par, Default::default());
+        let mut buf = self.buffer(req)?;
+        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.a_values);
+        let res = self.symbolic.factorize_numeric_llt(
+            &mut self.values,
+            a,
+            Side::Upper,
+            LltRegularization::default(),
+            self.par,
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        match res {
+            Ok(_) => {}
+            Err(LltError::NonPositivePivot { index }) => {
+                return Err(EigenError::NotPositiveDefinite { pivot: index })
+            }
+        }
+        self.kind = Some(Kind::Llt);
+        self.shift = sigma;
+        Ok(())
+    }
+
+    /// `K − σM = LDLᵀ` without pivoting; returns the number of negative pivots
+    /// (= eigenvalues below σ by Sylvester's law of inertia).
+    pub fn factor_ldlt(&mut self, sigma: f64) -> Result<usize, EigenError> {
+        self.kind = None;
+        self.fill(sigma)?;
+        let req = self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default());
+        let mut buf = self.buffer(req)?;
+        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.a_values);
+        let res = self.symbolic.factorize_numeric_ldlt(
+            &mut self.values,
+            a,
+            Side::Upper,
+            LdltRegularization::default(),
+            self.par,
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        match res {
+            Ok(_) => {}
+            Err(LdltError::ZeroPivot { index }) => {
+                return Err(EigenError::ZeroPivot { pivot: index, shift: sigma })
+            }
+        }
+        self.kind = Some(Kind::Ldlt);
+        self.shift = sigma;
+        Ok(self.negative_pivots())
+    }
+
+    /// Negative entries of D in the current LDLᵀ factor (NaN pivots count as negative).
+    fn negative_pivots(&self) -> usize {
+        let neg = |d: f64| d <= 0.0 || d.is_nan();
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let cp = s.col_ptr();
+                (0..s.nrows()).filter(|&j| neg(self.values[cp[j]])).count()
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let f = SupernodalLdltRef::new(s, &self.values);
+                let mut count = 0;
+                for i in 0..s.n_supernodes() {
+                    let v = f.supernode(i).val();
+                    for c in 0..v.ncols() {
+                        if neg(v[(c, c)]) {
+                            count += 1;
+                        }
+                    }
+                }
+                count
+            }
+        }
+    }
+
+    /// Solve workspace requirement for `ncols` right-hand sides.
+    pub fn solve_scratch(&self, ncols: usize) -> StackReq {
+        self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par)
+    }
+
+    /// Solves `(K − σM) X = B` in place with the current factor.
+    pub fn solve_in_place(&self, rhs: MatMut<'_, f64>, stack: &mut MemStack) {
+        match self.kind {
+            Some(Kind::Llt) => LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+                faer::Conj::No,
+                rhs,
+                self.par,
+                stack,
+            ),
+            Some(Kind::Ldlt) => LdltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+                faer::Conj::No,
+                rhs,
+                self.par,
+                stack,
+            ),
+            None => panic!("solve_in_place called without a numeric factor"),
+        }
+    }
+}

@@ -1,0 +1,377 @@
+//! The driver: validation, ordering, shift choice, searches, final Rayleigh–Ritz,
+//! residuals and the Sylvester inertia proof of completeness.
+//!
+//! Shift choice ("scaled to the problem"): with `λ_lo = (2π f_min)²`, the LDLᵀ of `K − λ_lo M`
+//! counts the eigenvalues below the band (ν_lo, rigid ones included). If few elastic modes lie
+//! below the band, the operator shift is `σ = −max(λ_lo, 1e-8·λ_scale)` where
+//! `λ_scale = maxᵢ Kᵢᵢ/Mᵢᵢ` estimates the top of the spectrum; this keeps `K − σM` positive
+//! definite with condition ≲ 1e8 whatever the units, so Cholesky is used. If many modes lie
+//! below the band (ultrasonic bands), the LDLᵀ factor at `σ = λ_lo` itself is the operator.
+
+use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation};
+use crate::factor::ShiftedFactor;
+use crate::krylov::{residuals, search, Counters, KsConfig};
+use crate::types::*;
+use faer::linalg::matmul::matmul;
+use faer::sparse::SparseColMatRef;
+use faer::{Accum, Mat, MatRef, Par};
+use std::time::Instant;
+
+/// Elastic modes below the band up to which the operator shift goes below the spectrum.
+const MAX_BELOW_FOR_LOW_SHIFT: usize = 24;
+/// Searches for missed modes after an inertia mismatch.
+const MAX_SEARCHES: usize = 4;
+
+/// Computes the elastic modes of `K w = λ M w` in the band of `opts` (see the crate docs).
+///
+/// `k`, `m`: n × n, full symmetric storage, K positive semi-definite, M positive definite.
+/// `rigid_fields`: n × r raw rigid-body fields (any basis, need not be orthonormal) spanning
+/// the null space of K; they are M-orthonormalized and deflated. `None` if K is nonsingular.
+pub fn solve(
+    k: &faer::sparse::SparseColMat<usize, f64>,
+    m: &faer::sparse::SparseColMat<usize, f64>,
+    rigid_fields: Option<MatRef<'_, f64>>,
+    opts: &EigenOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<EigenSolution, EigenError> {
+    let (k, m) = (k.as_ref(), m.as_ref());
+    validate(k, m, rigid_fields, opts)?;
+    let n = k.nrows();
+    let par = if opts.threads <= 1 { Par::Seq } else { Par::rayon(opts.threads) };
+    let mut stats = SolveStats::default();
+    let lam_lo = hz_to_lambda(opts.min_freq_hz);
+    let lam_hi = hz_to_lambda(opts.max_freq_hz);
+    let lam_scale = spectrum_scale(k, m)?;
+
+    // Rigid-body deflation.
+    let mut defl = Deflation::empty(n);
+    if let Some(r) = rigid_fields {
+        if r.ncols() > 0 {
+            let mut z = r.to_owned();
+            let (rank, _) = svqb(m, z.as_mut(), 1e-8);
+            defl.extend(m, z.as_ref().subcols(0, rank));
+        }
+    }
+    stats.rigid_modes_removed = defl.len();
+    let n_rigid = defl.len();
+
+    // Ordering + symbolic analysis.
+    progress(Progress::PhaseStart(Phase::Symbolic));
+    let t = Instant::now();
+    let use_metis = matches!(opts.ordering, Ordering::Metis | Ordering::Auto);
+    let mut factor = ShiftedFactor::analyze(k, m, use_metis, par)?;
+    stats.symbolic_s = t.elapsed().as_secs_f64();
+    stats.ordering = Some(factor.ordering);
+    stats.factor_nnz = factor.factor_nnz();
+    progress(Progress::PhaseEnd { phase: Phase::Symbolic, seconds: stats.symbolic_s });
+
+    let block = opts.block_size.min(n.saturating_sub(n_rigid).max(1));
+    let nev_guess = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
+    let ncv_guess = (2 * nev_guess).max(nev_guess + 3 * block);
+    stats.memory_estimate_bytes = factor.memory_estimate() + (n * (ncv_guess + 4 * block) * 8) as u64;
+    if let Some(limit) = opts.memory_limit_bytes.or_else(default_memory_limit) {
+        if stats.memory_estimate_bytes > limit {
+            return Err(EigenError::MemoryLimit { estimated: stats.memory_estimate_bytes, limit });
+        }
+    }
+
+    // Lower inertia count and shift choice.
+    progress(Progress::PhaseStart(Phase::Factor));
+    let t = Instant::now();
+    let nu_lo = if lam_lo > 0.0 {
+        stats.factorizations += 1;
+        inertia(&mut factor, lam_lo)?
+    } else {
+        n_rigid
+    };
+    let elastic_below = nu_lo.saturating_sub(n_rigid);
+    stats.elastic_below_band = elastic_below;
+    let low_shift = lam_lo == 0.0 || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
+    if low_shift {
+        let sigma = -lam_lo.max(1e-8 * lam_scale);
+        stats.factorizations += 1;
+        factor.factor_llt(sigma)?;
+    }
+    stats.shift = factor.shift();
+    stats.factor_s = t.elapsed().as_secs_f64();
+    progress(Progress::PhaseEnd { phase: Phase::Factor, seconds: stats.factor_s });
+
+    // Known eigenpairs (λ ascending after each merge).
+    let mut known = Known::default();
+    let below_known = if low_shift { elastic_below } else { 0 };
+    let mut wanted = below_known + opts.max_modes;
+    let cap = opts.max_modes;
+    let mut counters = Counters { restarts: 0, block_solves: 0 };
+    let mut searches = 0usize;
+    let t_iter = Instant::now();
+    let mut check_s = 0.0;
+    progress(Progress::PhaseStart(Phase::Iterate));
+    loop {
+        searches += 1;
+        let free = n - defl.len();
+        let nev = wanted.min(free);
+        let ncv = (2 * nev).max(nev + 3 * block).min(free.saturating_sub(block));
+        let known_before = known.lambdas.clone();
+        let enough = |l: &[f64]| -> bool {
+            let mut all: Vec<f64> = known_before.iter().chain(l.iter()).cloned().collect();
+            all.sort_by(f64::total_cmp);
+            let in_band = all.iter().filter(|&&x| x >= lam_lo && x <= lam_hi).count();
+            in_band >= cap || l.iter().any(|&x| x > lam_hi) || all.len() >= free
+        };
+        let out = if ncv < nev + block || free <= 2 * block + nev {
+            dense_all(k, m, &defl)?
+        } else {
+            let cfg = KsConfig {
+                nev,
+                ncv,
+                block,
+                max_restarts: opts.max_restarts,
+                tol: opts.tolerance,
+                seed: 0x5EED_0000 + searches as u64,
+            };
+            search(&factor, k, m, &defl, &cfg, &enough, &mut counters, progress)?
+        };
+        known.merge(out.lambdas, out.vectors, m, &mut defl);
+
+        // Select, polish, check.
+        let t_check = Instant::now();
+        progress(Progress::PhaseStart(Phase::Check));
+        let sel: Vec<usize> = (0..known.lambdas.len())
+            .filter(|&i| known.lambdas[i] >= lam_lo && known.lambdas[i] <= lam_hi)
+            .take(cap)
+            .collect();
+        let capped = sel.len() == cap;
+        let (lams, vecs) = polish(k, m, &known, &sel)?;
+        let res = residuals(k, m, &lams, vecs.as_ref());
+        let sigma_hi = upper_check_shift(&known.lambdas, &lams, capped, lam_hi);
+        stats.factorizations += 1;
+        let nu_hi = inertia(&mut factor, sigma_hi)?;
+        // Known elastic eigenvalues in [λ_lo, σ'): the returned ones plus converged ones
+        // beyond the cap (e.g. the rest of a multiplet split by `max_modes`).
+        let in_check = known.lambdas.iter().filter(|&&x| x >= lam_lo && x < sigma_hi).count();
+        let found = n_rigid + elastic_below + in_check.max(lams.len());
+        stats.inertia_expected = nu_hi;
+        stats.inertia_found = found;
+        stats.inertia_shift = sigma_hi;
+        let dt = t_check.elapsed().as_secs_f64();
+        check_s += dt;
+        progress(Progress::PhaseEnd { phase: Phase::Check, seconds: dt });
+        let worst = res.iter().cloned().fold(0.0, f64::max);
+        if nu_hi == found && worst <= opts.tolerance {
+            stats.block_solves = counters.block_solves;
+            stats.iterations = counters.restarts;
+            stats.check_s = check_s;
+            stats.solve_s = t_iter.elapsed().as_secs_f64() - check_s;
+            progress(Progress::PhaseEnd { phase: Phase::Iterate, seconds: stats.solve_s });
+            return Ok(EigenSolution { eigenvalues: lams, vectors: vecs, residuals: res, stats });
+        }
+        if nu_hi < found || searches >= MAX_SEARCHES {
+            return Err(EigenError::InertiaMismatch { expected: nu_hi, found });
+        }
+        // Missed modes: search again with everything found so far deflated.
+        if !low_shift || factor.shift() != stats.shift {
+            refactor_operator(&mut factor, stats.shift, low_shift)?;
+            stats.factorizations += 1;
+        }
+        wanted = nu_hi - found + block;
+    }
+}
+
+/// Re-establishes the operator factor after an inertia factorization replaced it.
+fn refactor_operator(f: &mut ShiftedFactor<'_>, sigma: f64, low: bool) -> Result<(), EigenError> {
+    if low {
+        f.factor_llt(sigma)
+    } else {
+        f.factor_ldlt(sigma).map(|_| ())
+    }
+}
+
+/// LDLᵀ inertia at σ, nudging σ by 1e-9 relative on an exactly zero pivot.
+fn inertia(f: &mut ShiftedFactor<'_>, sigma: f64) -> Result<usize, EigenError> {
+    match f.factor_ldlt(sigma) {
+        Err(EigenError::ZeroPivot { .. }) => f.factor_ldlt(sigma * (1.0 - 1e-9)),
+        r => r,
+    }
+}
+
+/// σ' for the upper inertia count: f_max if the band was not capped, otherwise between the
+/// highest returned eigenvalue and the next known one (or 1e-6 relative above it).
+fn upper_check_shift(all: &[f64], returned: &[f64], capped: bool, lam_hi: f64) -> f64 {
+    let Some(&top) = returned.last() else { return lam_hi };
+    if !capped {
+        return lam_hi;
+    }
+    let next = all.iter().cloned().filter(|&x| x > top * (1.0 + 1e-9)).fold(f64::INFINITY, f64::min);
+    let bump = top * (1.0 + 1e-6);
+    if next.is_finite() {
+        (0.5 * (top + next)).min(bump)
+    } else {
+        bump
+    }
+}
+
+/// All converged eigenpairs so far (λ ascending).
+#[derive(Default)]
+struct Known {
+    lambdas: Vec<f64>,
+    vectors: Option<Mat<f64>>,
+}
+
+impl Known {
+    /// Adds new pairs, sorts, and deflates them for later searches.
+    fn merge(&mut self, l: Vec<f64>, v: Mat<f64>, m: SparseColMatRef<'_, usize, f64>, defl: &mut Deflation) {
+        // New pairs are M-orthogonal to everything deflated (old pairs and rigid modes).
+        let mut lam = std::mem::take(&mut self.lambdas);
+        lam.extend(&l);
+        let all = match self.vectors.take() {
+            Some(old) => hcat(old.as_ref(), v.as_ref()),
+            None => v.clone(),
+        };
+        let mut order: Vec<usize> = (0..lam.len()).collect();
+        order.sort_by(|&a, &b| lam[a].total_cmp(&lam[b]));
+        let mut sorted = Mat::<f64>::zeros(all.nrows(), order.len());
+        for (c, &o) in order.iter().enumerate() {
+            sorted.as_mut().col_mut(c).copy_from(all.col(o));
+        }
+        self.lambdas = order.iter().map(|&o| lam[o]).collect();
+        self.vectors = Some(sorted);
+        defl.extend(m, v.as_ref());
+    }
+}
+
+/// Final Rayleigh–Ritz on the selected known vectors.
+fn polish(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    known: &Known,
+    sel: &[usize],
+) -> Result<(Vec<f64>, Mat<f64>), EigenError> {
+    let n = k.nrows();
+    let Some(all) = &known.vectors else { return Ok((Vec::new(), Mat::zeros(n, 0))) };
+    let mut y = Mat::<f64>::zeros(n, sel.len());
+    for (c, &i) in sel.iter().enumerate() {
+        y.as_mut().col_mut(c).copy_from(all.col(i));
+    }
+    rayleigh_ritz_kM(k, m, y)
+}
+
+/// Dense fallback for tiny problems: every eigenpair of the deflated problem.
+fn dense_all(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    defl: &Deflation,
+) -> Result<crate::krylov::KsOutput, EigenError> {
+    let n = k.nrows();
+    let mut q = Mat::<f64>::identity(n, n);
+    defl.project_out(q.as_mut());
+    defl.project_out(q.as_mut());
+    let (rank, _) = svqb(m, q.as_mut(), 1e-7);
+    let q = q.as_ref().subcols(0, rank.min(n - defl.len()));
+    if q.ncols() == 0 {
+        let empty = Mat::zeros(n, 0);
+        return Ok(crate::krylov::KsOutput {
+            lambdas: Vec::new(),
+            vectors: empty,
+            residuals: Vec::new(),
+            restarts: 0,
+            block_solves: 0,
+        });
+    }
+    let kq0 = spmm(k, q);
+    let kq = tmul(q, kq0.as_ref());
+    let (lambdas, u) =
+        sym_eig(kq.as_ref()).ok_or_else(|| EigenError::Factorization("dense eigensolver failed".into()))?;
+    let mut w = Mat::<f64>::zeros(n, q.ncols());
+    matmul(w.as_mut(), Accum::Replace, q, u.as_ref(), 1.0, Par::Seq);
+    let residuals = residuals(k, m, &lambdas, w.as_ref());
+    Ok(crate::krylov::KsOutput { lambdas, vectors: w, residuals, restarts: 0, block_solves: 0 })
+}
+
+/// maxᵢ Kᵢᵢ / Mᵢᵢ, an estimate of the top of the spectrum; errors on Mᵢᵢ ≤ 0.
+fn spectrum_scale(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+) -> Result<f64, EigenError> {
+    let diag = |a: SparseColMatRef<'_, usize, f64>, j: usize| -> f64 {
+        let rows = a.symbolic().row_idx_of_col_raw(j);
+        let vals = a.val_of_col(j);
+        rows.iter().zip(vals).filter(|(&r, _)| r == j).map(|(_, &v)| v).sum()
+    };
+    let mut scale = 0.0f64;
+    for j in 0..k.ncols() {
+        let mj = diag(m, j);
+        if mj <= 0.0 || mj.is_nan() {
+            return Err(EigenError::NotPositiveDefinite { pivot: j });
+        }
+        scale = scale.max(diag(k, j) / mj);
+    }
+    if scale <= 0.0 || scale.is_nan() {
+        return Err(EigenError::InvalidOption {
+            name: "K",
+            reason: "stiffness matrix has no positive diagonal entry".into(),
+        });
+    }
+    Ok(scale)
+}
+
+/// 75 % of MemAvailable from /proc/meminfo.
+fn default_memory_limit() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024 / 4 * 3)
+}
+
+fn validate(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    rigid: Option<MatRef<'_, f64>>,
+    o: &EigenOptions,
+) -> Result<(), EigenError> {
+    if k.nrows() != k.ncols() || m.nrows() != m.ncols() || k.nrows() != m.nrows() || k.nrows() == 0 {
+        return Err(EigenError::Shape {
+            k_rows: k.nrows(),
+            k_cols: k.ncols(),
+            m_rows: m.nrows(),
+            m_cols: m.ncols(),
+        });
+    }
+    for (name, a) in [("K", k), ("M", m)] {
+        for j in 0..a.ncols() {
+            let rows = a.symbolic().row_idx_of_col_raw(j);
+            if let Some(p) = a.val_of_col(j).iter().position(|v| !v.is_finite()) {
+                return Err(EigenError::NonFinite { matrix: name, row: rows[p], col: j });
+            }
+        }
+    }
+    if let Some(r) = rigid {
+        if r.nrows() != k.nrows() {
+            return Err(EigenError::RigidShape { rows: r.nrows(), expected: k.nrows() });
+        }
+        for j in 0..r.ncols() {
+            for i in 0..r.nrows() {
+                if !r[(i, j)].is_finite() {
+                    return Err(EigenError::NonFinite { matrix: "rigid fields", row: i, col: j });
+                }
+            }
+        }
+    }
+    let bad =
+        |name: &'static str, reason: &str| Err(EigenError::InvalidOption { name, reason: reason.into() });
+    if o.min_freq_hz < 0.0 || !o.min_freq_hz.is_finite() {
+        return bad("min_freq_hz", "must be finite and >= 0");
+    }
+    if o.max_freq_hz <= o.min_freq_hz || !o.max_freq_hz.is_finite() {
+        return bad("max_freq_hz", "must be finite and above min_freq_hz");
+    }
+    if o.max_modes == 0 {
+        return bad("max_modes", "must be at least 1");
+    }
+    if !(o.tolerance > 0.0 && o.tolerance < 1e-2) {
+        return bad("tolerance", "must be in (0, 1e-2)");
+    }
+    if o.block_size == 0 || o.block_size > 64 {
+        return bad("block_size", "must be in 1..=64");
+    }
+    Ok(())
+}
