@@ -8,4 +8,5 @@ mod bar;
 mod common;
 mod mass;
 mod patch;
+mod reference;
 mod rigid_modes;
