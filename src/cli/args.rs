@@ -42,19 +42,19 @@ pub struct MaterialArgs {
     #[arg(long)]
     pub material: Option<String>,
     /// Young's modulus E [Pa] (overrides the preset's).
-    #[arg(long, value_name = "PA")]
+    #[arg(long, value_name = "PA", allow_negative_numbers = true)]
     pub youngs: Option<f64>,
     /// Poisson's ratio ν (overrides the preset's).
-    #[arg(long, value_name = "NU")]
+    #[arg(long, value_name = "NU", allow_negative_numbers = true)]
     pub poisson: Option<f64>,
     /// Density ρ [kg/m³] (overrides the preset's).
-    #[arg(long, value_name = "KG_M3")]
+    #[arg(long, value_name = "KG_M3", allow_negative_numbers = true)]
     pub density: Option<f64>,
     /// Rayleigh mass-proportional damping α [1/s] in C = αM + βK.
-    #[arg(long, value_name = "A")]
+    #[arg(long, value_name = "A", allow_negative_numbers = true)]
     pub alpha: Option<f64>,
     /// Rayleigh stiffness-proportional damping β [s] in C = αM + βK.
-    #[arg(long, value_name = "B")]
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
     pub beta: Option<f64>,
 }
 
@@ -65,7 +65,7 @@ pub struct MeshInputArgs {
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
     /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres).
-    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
     pub scale: f64,
     /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY).
     #[arg(long, value_name = "H")]
@@ -86,7 +86,7 @@ pub enum MeshShape {
     /// Box [0,X]×[0,Y]×[0,Z] of structured tets.
     Box {
         /// Edge lengths X,Y,Z [m].
-        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
         size: [f64; 3],
         #[command(flatten)]
         common: GenerateArgs,
@@ -146,7 +146,7 @@ pub enum MeshShape {
         #[arg(long, value_name = "H")]
         cell: Option<f64>,
         /// Multiply all coordinates by S.
-        #[arg(long, value_name = "S", default_value_t = 1.0)]
+        #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
         scale: f64,
         /// Object of a multi-object file to mesh.
         #[arg(long)]
@@ -210,7 +210,7 @@ pub struct PrecomputeArgs {
     #[arg(long, value_name = "HZ", default_value_t = 20_000.0)]
     pub max_freq: f64,
     /// Clamp every node inside the box X0,Y0,Z0,X1,Y1,Z1 [m].
-    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box)]
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box, allow_hyphen_values = true)]
     pub fix_box: Option<[f64; 6]>,
     /// Recompute even when the cache holds the result.
     #[arg(long)]
@@ -245,7 +245,7 @@ pub struct RetuneArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// Scale every length by S (frequencies scale by 1/S).
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub scale: Option<f64>,
     /// Output mode bank.
     #[arg(short, long)]
@@ -269,28 +269,28 @@ pub struct StrikeArgs {
     /// Mode bank.
     pub bank: PathBuf,
     /// Struck point X,Y,Z [m] (snapped to the nearest surface point); repeat for several strikes.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, required = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, required = true, allow_hyphen_values = true)]
     pub at: Vec<[f64; 3]>,
     /// Impulse direction X,Y,Z (default: into the surface); one, or one per --at.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub dir: Vec<[f64; 3]>,
     /// Impulse magnitude [N·s]; one, or one per --at.
-    #[arg(long, value_name = "NS")]
+    #[arg(long, value_name = "NS", allow_negative_numbers = true)]
     pub impulse: Vec<f64>,
     /// Strike time [s]; one, or one per --at.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub time: Vec<f64>,
     /// Contact time τ [s] of the half-sine force.
     #[arg(long, value_name = "S", conflicts_with = "hertz")]
     pub contact_time: Option<f64>,
     /// Hertz contact of a sphere of MASS_KG and RADIUS_M striking at 1 m/s.
-    #[arg(long, value_name = "MASS_KG,RADIUS_M", value_parser = parse_pair)]
+    #[arg(long, value_name = "MASS_KG,RADIUS_M", value_parser = parse_pair, allow_hyphen_values = true)]
     pub hertz: Option<[f64; 2]>,
     /// Contact microphone position X,Y,Z [m] (default: the first struck point).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub mic: Option<[f64; 3]>,
     /// Duration [s] (default: until the sound decayed by 60 dB).
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Sample rate [Hz].
     #[arg(long, value_name = "HZ", default_value_t = 48_000)]

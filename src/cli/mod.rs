@@ -10,6 +10,7 @@ mod mesh;
 mod output;
 mod precompute;
 mod progress;
+mod strike;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -40,6 +41,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Retune(args)) => bank_cmds::retune(args),
         Some(Command::Export(args)) => bank_cmds::export(args),
         Some(Command::Mesh(args)) => mesh::run(args.shape),
+        Some(Command::Strike(args)) => strike::run(args),
         Some(_) => anyhow::bail!("not implemented yet"),
     }
 }

@@ -1,0 +1,202 @@
+//! `modal strike`: strike a bank at surface points and write the sound.
+
+use anyhow::{bail, ensure, Context, Result};
+use modal_bank::ModeBank;
+use modal_synth::{
+    contact, render_strikes, OutputGain, RenderLength, Strike, SynthModel, SynthOptions, WavFormat, WavGain,
+    DEFAULT_CONTACT_TIME_S,
+};
+use serde::Serialize;
+
+use super::args::StrikeArgs;
+use super::bank_cmds::load_bank;
+use super::output::{print_json, warn};
+
+/// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
+pub const DEFAULT_IMPULSE_NS: f64 = 0.01;
+/// Longest automatic duration [s]; a fade-out ends sounds that ring longer.
+pub const AUTO_DURATION_CAP_S: f64 = 30.0;
+/// Level of `--normalize`: peak at −1 dBFS.
+const NORMALIZED_PEAK: f64 = 0.891;
+/// Approach speed [m/s] assumed by `--hertz` (t_c ∝ v^{−1/5}, so it matters little).
+const HERTZ_SPEED_M_S: f64 = 1.0;
+
+#[derive(Serialize)]
+struct StrikeJson {
+    out: String,
+    sample_rate: u32,
+    duration_s: f64,
+    capped: bool,
+    contact_time_s: f64,
+    strikes: Vec<StrikePointJson>,
+    top_modes: Vec<TopModeJson>,
+    peak: f64,
+    clipped_samples: usize,
+    modes_total: usize,
+    modes_skipped: usize,
+    mode_samples: u64,
+}
+
+#[derive(Serialize)]
+struct StrikePointJson {
+    requested: [f64; 3],
+    surface_point: [f64; 3],
+    distance_m: f64,
+    impulse_ns: [f64; 3],
+    time_s: f64,
+}
+
+#[derive(Serialize)]
+struct TopModeJson {
+    mode: usize,
+    frequency_hz: f64,
+    amplitude: f64,
+    t60_s: Option<f64>,
+}
+
+/// The k-th value of a per-strike list: one value applies to all strikes.
+fn nth<T: Copy>(values: &[T], k: usize, default: T, name: &str, strikes: usize) -> Result<T> {
+    match values.len() {
+        0 => Ok(default),
+        1 => Ok(values[0]),
+        n if n == strikes => Ok(values[k]),
+        n => bail!("--{name} given {n} times for {strikes} strikes: give it once or once per --at"),
+    }
+}
+
+fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f64> {
+    if let Some(tau) = args.contact_time {
+        return Ok(tau);
+    }
+    let Some([mass_kg, radius_m]) = args.hertz else {
+        return Ok(DEFAULT_CONTACT_TIME_S);
+    };
+    ensure!(mass_kg > 0.0 && radius_m > 0.0, "--hertz needs a positive mass and radius");
+    // A striker of the bank's own material hitting the (locally flat) surface.
+    let m = &bank.material;
+    let e_star = contact::effective_modulus(m.youngs_pa, m.poisson, m.youngs_pa, m.poisson);
+    let m_eff = contact::harmonic(mass_kg, bank.mass.mass_kg);
+    let speed = if impulse_ns > 0.0 { impulse_ns / mass_kg } else { HERTZ_SPEED_M_S };
+    contact::hertz_contact_time(m_eff, radius_m, e_star, speed).context("invalid --hertz parameters")
+}
+
+pub fn run(args: StrikeArgs) -> Result<()> {
+    let bank = load_bank(&args.bank)?;
+    let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
+    let n = args.at.len();
+    let mut strikes = Vec::with_capacity(n);
+    let mut points_json = Vec::with_capacity(n);
+    for (k, &at) in args.at.iter().enumerate() {
+        let point = model.locate(at).with_context(|| format!("--at {},{},{}", at[0], at[1], at[2]))?;
+        let magnitude = nth(&args.impulse, k, DEFAULT_IMPULSE_NS, "impulse", n)?;
+        ensure!(magnitude.is_finite() && magnitude >= 0.0, "--impulse must be a finite number >= 0 N·s");
+        // Default direction: into the surface.
+        let dir = nth(&args.dir, k, point.normal.map(|c| -c), "dir", n)?;
+        let norm = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+        ensure!(norm > 0.0, "--dir must not be the zero vector");
+        let impulse_ns = dir.map(|c| c / norm * magnitude);
+        let time_s = nth(&args.time, k, 0.0, "time", n)?;
+        let contact_time_s = contact_time(&args, &bank, magnitude)?;
+        strikes.push(Strike { time_s, at, impulse_ns, contact_time_s });
+        points_json.push(StrikePointJson {
+            requested: at,
+            surface_point: point.position,
+            distance_m: point.distance,
+            impulse_ns,
+            time_s,
+        });
+    }
+    let options = SynthOptions {
+        sample_rate: args.rate as f64,
+        gain: OutputGain::ContactMic { at: args.mic },
+        ..SynthOptions::default()
+    };
+    let length = match args.duration {
+        Some(d) => RenderLength::Fixed(d),
+        None => RenderLength::Auto { cap_s: AUTO_DURATION_CAP_S },
+    };
+    modal_synth::check_sample_rate(args.rate as f64)?;
+    let rendered = render_strikes(&bank, &strikes, &options, length)?;
+    let top_modes = top_modes(&bank, &strikes[0], &options)?;
+    let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
+    let gain = if args.normalize { WavGain::Normalize { peak: NORMALIZED_PEAK } } else { WavGain::default() };
+    let report = modal_synth::write_wav(&args.out, &[&rendered.samples], args.rate, format, gain)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    if report.clipped > 0 {
+        warn(&format!(
+            "{} samples clipped at full scale (use --float, --normalize or a smaller --impulse)",
+            report.clipped
+        ));
+    }
+    if rendered.capped {
+        warn(&format!("the sound rings longer than {AUTO_DURATION_CAP_S} s: faded out at the cap"));
+    }
+    let json = StrikeJson {
+        out: args.out.display().to_string(),
+        sample_rate: args.rate,
+        duration_s: rendered.duration_s,
+        capped: rendered.capped,
+        contact_time_s: strikes[0].contact_time_s,
+        strikes: points_json,
+        top_modes,
+        peak: report.peak,
+        clipped_samples: report.clipped,
+        modes_total: rendered.stats.modes_total,
+        modes_skipped: rendered.stats.modes_skipped,
+        mode_samples: rendered.stats.mode_samples,
+    };
+    if args.json {
+        return print_json(&json);
+    }
+    print_human(&json);
+    Ok(())
+}
+
+/// The loudest modes the first strike excites.
+fn top_modes(bank: &ModeBank, strike: &Strike, options: &SynthOptions) -> Result<Vec<TopModeJson>> {
+    let voice = modal_synth::ModalVoice::new(bank, options.clone())?;
+    let point = voice.locate(strike.at.into())?;
+    Ok(voice
+        .excitation(&point, strike.impulse_ns, strike.contact_time_s)
+        .into_iter()
+        .take(8)
+        .map(|m| TopModeJson {
+            mode: m.mode,
+            frequency_hz: m.frequency_hz,
+            amplitude: m.amplitude,
+            t60_s: (m.decay_rate > 0.0).then(|| 1000f64.ln() / m.decay_rate),
+        })
+        .collect())
+}
+
+fn print_human(json: &StrikeJson) {
+    for (k, s) in json.strikes.iter().enumerate() {
+        println!(
+            "strike {}: t = {:.4} s at ({:.4}, {:.4}, {:.4}) m (snapped {:.2e} m), impulse ({:.3e}, {:.3e}, {:.3e}) N·s",
+            k + 1,
+            s.time_s,
+            s.surface_point[0],
+            s.surface_point[1],
+            s.surface_point[2],
+            s.distance_m,
+            s.impulse_ns[0],
+            s.impulse_ns[1],
+            s.impulse_ns[2]
+        );
+    }
+    println!("contact time {:.3e} s; loudest modes excited by the first strike:", json.contact_time_s);
+    for m in &json.top_modes {
+        let t60 = m.t60_s.map_or("inf".into(), |t| format!("{t:.3} s"));
+        println!(
+            "  mode {:>3}  {:>10.2} Hz  amplitude {:.3e} m/s  T60 {}",
+            m.mode + 1,
+            m.frequency_hz,
+            m.amplitude,
+            t60
+        );
+    }
+    println!(
+        "wrote {} ({:.3} s at {} Hz, peak {:.3} of full scale, {} of {} modes skipped as inaudible)",
+        json.out, json.duration_s, json.sample_rate, json.peak, json.modes_skipped, json.modes_total
+    );
+}

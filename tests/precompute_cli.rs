@@ -1,0 +1,136 @@
+//! End-to-end tests of `modal precompute`, `info`, `retune`, `export` and
+//! `export-matrices` through the binary: the `--json` contract, the cache,
+//! and retuning against a fresh solve.
+
+mod common;
+use common::*;
+use serde_json::Value;
+
+fn frequencies(json: &Value) -> Vec<f64> {
+    json["modes"].as_array().unwrap().iter().map(|m| m["frequency_hz"].as_f64().unwrap()).collect()
+}
+
+fn precompute(dir: &std::path::Path, out: &str, extra: &[&str]) -> Value {
+    let bar = example("bar_p1.msh");
+    let mut args = vec!["precompute", bar.to_str().unwrap(), "-o", out, "--modes", "8", "--json"];
+    args.extend(extra);
+    modal(dir, &args).ok().json()
+}
+
+#[test]
+fn json_contract_cache_and_info_agree() {
+    let dir = temp_dir();
+    let mut flags = STEEL.to_vec();
+    flags.extend(["--alpha", "5", "--beta", "3e-8"]);
+    let first = precompute(dir.path(), "a.bank", &flags);
+    for key in
+        ["modes", "dofs", "order", "mass_kg", "rigid_modes_removed", "inertia_check", "cached", "timings_s"]
+    {
+        assert!(first.get(key).is_some(), "missing key {key}");
+    }
+    for key in ["frequency_hz", "damped_frequency_hz", "damping_ratio", "decay_rate", "residual"] {
+        assert!(first["modes"][0].get(key).is_some(), "missing mode key {key}");
+    }
+    assert_eq!(first["cached"], false);
+    assert_eq!(first["order"], 2);
+    assert_eq!(first["rigid_modes_removed"], 6);
+    assert_eq!(first["inertia_check"]["expected"], first["inertia_check"]["found"]);
+    assert!((first["mass_kg"].as_f64().unwrap() - 0.471).abs() < 1e-9);
+    let f = frequencies(&first);
+    assert_eq!(f.len(), 8);
+    assert!(f.windows(2).all(|w| w[0] <= w[1]), "ascending");
+    // First flat bending of the reference bar: 574.27 Hz (3D converged).
+    assert!((f[0] / 574.27 - 1.0).abs() < 0.01, "first mode {} Hz", f[0]);
+    // Rayleigh damping: d = (α + β ω²)/2.
+    let w = 2.0 * std::f64::consts::PI * f[0];
+    let d = first["modes"][0]["decay_rate"].as_f64().unwrap();
+    assert!((d - (5.0 + 3e-8 * w * w) / 2.0).abs() < 1e-9 * d);
+    for m in first["modes"].as_array().unwrap() {
+        assert!(m["residual"].as_f64().unwrap() <= 1e-8);
+    }
+
+    // Same inputs again: a cache hit printing exactly the same values.
+    let second = precompute(dir.path(), "b.bank", &flags);
+    assert_eq!(second["cached"], true);
+    let strip = |mut v: Value| {
+        v["cached"] = Value::Null;
+        v
+    };
+    assert_eq!(strip(first.clone()), strip(second));
+
+    // info prints the same object for the bank.
+    let info = modal(dir.path(), &["info", "a.bank", "--json"]).ok().json();
+    assert_eq!(strip(first.clone()), strip(info));
+
+    // Any change of input misses the cache (here: damping).
+    let mut changed = STEEL.to_vec();
+    changed.extend(["--alpha", "6", "--beta", "3e-8"]);
+    assert_eq!(precompute(dir.path(), "c.bank", &changed)["cached"], false);
+}
+
+#[test]
+fn retune_matches_a_fresh_solve() {
+    let dir = temp_dir();
+    let steel = precompute(dir.path(), "steel.bank", &STEEL);
+    // Aluminium-like: same ν, new E and ρ; λ' = λ (E'/E)/(ρ'/ρ).
+    let retuned = modal(
+        dir.path(),
+        &["retune", "steel.bank", "--youngs", "70e9", "--density", "2700", "-o", "al.bank", "--json"],
+    )
+    .ok()
+    .json();
+    let fresh =
+        precompute(dir.path(), "fresh.bank", &["--youngs", "70e9", "--poisson", "0.3", "--density", "2700"]);
+    let ratio = ((70e9 / 200e9) / (2700.0 / 7850.0) as f64).sqrt();
+    for ((r, f), s) in frequencies(&retuned).iter().zip(frequencies(&fresh)).zip(frequencies(&steel)) {
+        assert!((r / f - 1.0).abs() < 1e-7, "retuned {r} vs fresh {f}");
+        assert!((r / (s * ratio) - 1.0).abs() < 1e-12);
+    }
+    assert_eq!(retuned["cached"], false);
+    // A different ν needs a new solve.
+    modal(dir.path(), &["retune", "steel.bank", "--poisson", "0.33", "-o", "x.bank"]).fails_with("poisson");
+    assert!(!dir.path().join("x.bank").exists());
+}
+
+#[test]
+fn clamped_bar_is_a_cantilever() {
+    let dir = temp_dir();
+    // Clamp the end x = 0 of the 0.3 m bar.
+    let mut flags = STEEL.to_vec();
+    flags.extend(["--fix-box", "-1,-1,-1,1e-9,1,1"]);
+    let json = precompute(dir.path(), "c.bank", &flags);
+    assert_eq!(json["rigid_modes_removed"], 0);
+    assert_eq!(json["inertia_check"]["expected"], json["inertia_check"]["found"]);
+    // Euler–Bernoulli clamped-free: f = (1.875104)² / (2π L²) √(EI/ρA), flat bending across h = 0.01.
+    let (l, h) = (0.3, 0.01_f64);
+    let eb =
+        1.875104_f64.powi(2) / (2.0 * std::f64::consts::PI * l * l) * (200e9 * h * h / 12.0 / 7850.0).sqrt();
+    let f0 = frequencies(&json)[0];
+    assert!((f0 / eb - 1.0).abs() < 0.02, "cantilever {f0} Hz vs beam theory {eb} Hz");
+}
+
+#[test]
+fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
+    let dir = temp_dir();
+    precompute(dir.path(), "a.bank", &STEEL);
+    modal(dir.path(), &["export", "a.bank", "--vtk", "a.vtu"]).ok();
+    let vtu = std::fs::read_to_string(dir.path().join("a.vtu")).unwrap();
+    assert!(vtu.contains("UnstructuredGrid") && vtu.matches("<DataArray").count() >= 8);
+
+    let bar = example("bar_p1.msh");
+    let mut args = vec!["export-matrices", bar.to_str().unwrap(), "--out", "m", "--json"];
+    args.extend(STEEL);
+    let summary = modal(dir.path(), &args).ok().json();
+    let k = std::fs::read_to_string(dir.path().join("m/K.mtx")).unwrap();
+    let mut lines = k.lines().filter(|l| !l.starts_with('%'));
+    let header: Vec<usize> = lines.next().unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(header[0], summary["dofs"].as_u64().unwrap() as usize);
+    for line in lines.take(1000) {
+        let mut it = line.split_whitespace();
+        let (i, j): (usize, usize) =
+            (it.next().unwrap().parse().unwrap(), it.next().unwrap().parse().unwrap());
+        assert!(i >= j && j >= 1, "lower triangle, 1-based");
+    }
+    let nodes = std::fs::read_to_string(dir.path().join("m/nodes.csv")).unwrap();
+    assert_eq!(nodes.lines().count() - 1, header[0] / 3);
+}
