@@ -1,1 +1,44 @@
-//! modal-synth
+//! `modal-synth`: modal synthesis — strike a mode bank, render audio, write WAV.
+//!
+//! Input: a [`modal_bank::ModeBank`] (frequencies, Rayleigh decay rates,
+//! damping ratios, mass-normalized surface mode shapes) and impulses (time,
+//! surface point, N·s vector, contact time). Output: mono f32 samples (m/s of
+//! normal surface velocity for the default contact microphone) and WAV files.
+//!
+//! Each mode is a damped complex exponential advanced by one complex multiply
+//! per sample ([`kernel`]: f32 structure-of-arrays SIMD with an f64 scalar
+//! reference), re-anchored in f64 every block so the error never grows with
+//! duration, excited phase-exactly at fractional sample times with the exact
+//! half-sine contact spectrum ([`contact`]), and dropped once inaudible.
+//! [`ModalVoice`] is the streaming engine the scene mixes; [`render_strikes`]
+//! and [`write_wav`] serve the `modal strike` command. The math, units and
+//! conventions are in `docs/synthesis.md`.
+
+mod complex;
+pub mod contact;
+mod error;
+pub mod kernel;
+mod model;
+mod offline;
+mod options;
+pub mod surface;
+mod voice;
+mod wav;
+
+pub use complex::C64;
+pub use contact::{
+    effective_modulus, harmonic, hertz_contact_time, DEFAULT_CONTACT_TIME_S, MAX_CONTACT_TIME_S,
+};
+pub use error::SynthError;
+pub use model::{SynthModel, MAX_SNAP_FRACTION};
+pub use offline::{auto_duration, render_strikes, RenderLength, Rendered, Strike, MAX_DURATION_S};
+pub use options::{
+    check_sample_rate, Kernel, OutputGain, OutputQuantity, SynthOptions, MAX_FREQUENCY_FRACTION,
+    MAX_SAMPLE_RATE, MIN_FREQUENCY_HZ, MIN_SAMPLE_RATE,
+};
+pub use surface::SurfacePoint;
+pub use voice::{
+    ExcitedMode, ImpactPoint, ModalVoice, VoiceStats, ABSOLUTE_FLOOR, BLOCK, PARALLEL_MIN_MODES,
+    REANCHOR_BLOCKS,
+};
+pub use wav::{write_wav, WavFormat, WavGain, WavReport, DEFAULT_WAV_GAIN};

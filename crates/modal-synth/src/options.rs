@@ -1,0 +1,131 @@
+//! Options of a voice: sample rate, culling, output gain model, kernel.
+
+use crate::error::SynthError;
+
+/// Lowest accepted sample rate [Hz].
+pub const MIN_SAMPLE_RATE: f64 = 8_000.0;
+/// Highest accepted sample rate [Hz].
+pub const MAX_SAMPLE_RATE: f64 = 192_000.0;
+/// Modes whose damped frequency is below this are not synthesized [Hz].
+pub const MIN_FREQUENCY_HZ: f64 = 20.0;
+/// Modes whose damped frequency is at or above this fraction of the sample
+/// rate are not synthesized (no aliasing).
+pub const MAX_FREQUENCY_FRACTION: f64 = 0.45;
+
+/// What the output measures.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OutputQuantity {
+    /// `y = Σ g_i q̇_i`: with contact-mic gains, normal surface velocity [m/s].
+    #[default]
+    Velocity,
+    /// `y = Σ g_i q_i`: with contact-mic gains, normal surface displacement [m].
+    Displacement,
+}
+
+/// Per-mode output gains `g_i` (see `docs/synthesis.md`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum OutputGain {
+    /// Contact microphone: `g_i = φ_i(p_mic)·n(p_mic)` [1/√kg], the normal
+    /// surface motion at a point. `at: None` puts the microphone at the first
+    /// struck point (the first `add_impulse` call); `Some(x)` snaps `x` [m] to
+    /// the surface.
+    ContactMic {
+        /// Microphone position [m], or `None` for the first struck point.
+        at: Option<[f64; 3]>,
+    },
+    /// Radiation/listener proxy: `g_i` = area-weighted RMS over the surface of
+    /// `φ_i·n` [1/√kg], so the output is the RMS normal surface velocity [m/s]
+    /// (or displacement) that a mode's motion produces; distance attenuation
+    /// and delay belong to the listener (scene).
+    RadiationProxy,
+    /// Explicit gains, one per bank mode.
+    PerMode(Vec<f64>),
+}
+
+impl Default for OutputGain {
+    fn default() -> Self {
+        OutputGain::ContactMic { at: None }
+    }
+}
+
+/// Which kernel renders the samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Kernel {
+    /// f32 SIMD kernel with run-time CPU feature dispatch (AVX-512/AVX2+FMA).
+    #[default]
+    Auto,
+    /// f32 kernel without run-time dispatch (baseline target features).
+    Portable,
+    /// Scalar f64 reference recurrence (slow; for tests and error bounds).
+    Reference,
+}
+
+/// Options of a [`crate::ModalVoice`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthOptions {
+    /// Sample rate [Hz], 8 000 ..= 192 000.
+    pub sample_rate: f64,
+    /// A mode leaves the active set when its envelope falls this many dB
+    /// below the loudest active mode (negative, e.g. −100); `None` disables
+    /// relative culling (an absolute floor of 1e-30 output units remains so
+    /// that nothing reaches denormal range).
+    pub cull_db: Option<f64>,
+    /// Keep at most this many modes active, the loudest by current amplitude.
+    pub budget: Option<usize>,
+    /// Per-mode output gains.
+    pub gain: OutputGain,
+    /// Velocity or displacement output.
+    pub quantity: OutputQuantity,
+    /// Kernel choice.
+    pub kernel: Kernel,
+    /// Render chunks of modes on the rayon pool when a voice has at least
+    /// [`crate::PARALLEL_MIN_MODES`] active modes. Results are bit-identical
+    /// either way.
+    pub parallel: bool,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        SynthOptions {
+            sample_rate: 48_000.0,
+            cull_db: Some(-100.0),
+            budget: None,
+            gain: OutputGain::default(),
+            quantity: OutputQuantity::Velocity,
+            kernel: Kernel::Auto,
+            parallel: true,
+        }
+    }
+}
+
+/// Checks a sample rate: finite and within 8 kHz ..= 192 kHz.
+pub fn check_sample_rate(rate: f64) -> Result<(), SynthError> {
+    if rate.is_finite() && (MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&rate) {
+        Ok(())
+    } else {
+        Err(SynthError::SampleRate(rate))
+    }
+}
+
+impl SynthOptions {
+    /// Validates the options.
+    pub fn validate(&self) -> Result<(), SynthError> {
+        check_sample_rate(self.sample_rate)?;
+        if let Some(db) = self.cull_db {
+            if !db.is_finite() || db > 0.0 {
+                return Err(SynthError::InvalidOption { name: "cull_db", value: db });
+            }
+        }
+        if let OutputGain::ContactMic { at: Some(p) } = self.gain {
+            if !p.iter().all(|x| x.is_finite()) {
+                return Err(SynthError::InvalidPoint(p));
+            }
+        }
+        if let OutputGain::PerMode(g) = &self.gain {
+            if let Some(&bad) = g.iter().find(|x| !x.is_finite()) {
+                return Err(SynthError::InvalidOption { name: "gain", value: bad });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,156 @@
+//! WAV output (hound): 16-bit PCM or 32-bit float, mono or stereo, written
+//! atomically (temporary file in the destination directory, then rename; the
+//! temporary file is removed on any error).
+//!
+//! Level: a FIXED gain by default, [`DEFAULT_WAV_GAIN`] = 1 full scale per
+//! output unit (1 m/s of normal surface velocity for the contact microphone),
+//! so the file is linear in the impulse. `Normalize` scales the peak to a
+//! given level instead. Float files are written unclipped; PCM samples
+//! beyond full scale are clipped and counted.
+
+use crate::error::SynthError;
+use crate::options::check_sample_rate;
+use std::io::BufWriter;
+use std::path::Path;
+
+/// Default fixed gain: full scale per output unit (1 m/s ↦ 1.0).
+pub const DEFAULT_WAV_GAIN: f64 = 1.0;
+
+/// Sample encoding.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WavFormat {
+    /// 16-bit signed PCM (clipped at full scale).
+    #[default]
+    Pcm16,
+    /// 32-bit IEEE float (unclipped).
+    Float32,
+}
+
+/// Level applied before encoding.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WavGain {
+    /// Multiply by this constant.
+    Fixed(f64),
+    /// Scale so the largest |sample| equals `peak` (full scale = 1).
+    Normalize {
+        /// Target peak, e.g. 0.891 (−1 dBFS).
+        peak: f64,
+    },
+}
+
+impl Default for WavGain {
+    fn default() -> Self {
+        WavGain::Fixed(DEFAULT_WAV_GAIN)
+    }
+}
+
+/// What [`write_wav`] wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WavReport {
+    /// Channels (1 or 2).
+    pub channels: u16,
+    /// Frames (samples per channel).
+    pub frames: usize,
+    /// Sample rate [Hz].
+    pub sample_rate: u32,
+    /// Gain that was applied.
+    pub gain: f64,
+    /// Largest |sample| after the gain (full scale = 1).
+    pub peak: f64,
+    /// PCM samples clipped at full scale (always 0 for float).
+    pub clipped: usize,
+}
+
+/// Writes `channels` (1 or 2 equally long slices; stereo is interleaved in
+/// the file) to `path` at `sample_rate` Hz (8 000 ..= 192 000).
+pub fn write_wav(
+    path: &Path,
+    channels: &[&[f32]],
+    sample_rate: u32,
+    format: WavFormat,
+    gain: WavGain,
+) -> Result<WavReport, SynthError> {
+    check_sample_rate(sample_rate as f64)?;
+    let frames = match channels {
+        [a] => a.len(),
+        [a, b] if a.len() == b.len() => a.len(),
+        [a, b] => {
+            return Err(SynthError::WavChannels(format!("left has {} samples, right {}", a.len(), b.len())))
+        }
+        _ => {
+            return Err(SynthError::WavChannels(format!(
+                "{} channels given, 1 or 2 supported",
+                channels.len()
+            )))
+        }
+    };
+    if channels.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
+        return Err(SynthError::WavChannels("a sample is NaN or infinite".into()));
+    }
+    let raw_peak = channels.iter().flat_map(|c| c.iter()).fold(0.0f64, |m, &x| m.max((x as f64).abs()));
+    let g = match gain {
+        WavGain::Fixed(g) if g.is_finite() => g,
+        WavGain::Normalize { peak } if peak.is_finite() && peak > 0.0 => {
+            if raw_peak > 0.0 {
+                peak / raw_peak
+            } else {
+                1.0
+            }
+        }
+        WavGain::Fixed(v) | WavGain::Normalize { peak: v } => {
+            return Err(SynthError::InvalidOption { name: "wav gain", value: v })
+        }
+    };
+    let fail = |e: &dyn std::fmt::Display| SynthError::WavWrite {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".modal-wav-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| fail(&e))?;
+    let spec = hound::WavSpec {
+        channels: channels.len() as u16,
+        sample_rate,
+        bits_per_sample: if format == WavFormat::Pcm16 { 16 } else { 32 },
+        sample_format: if format == WavFormat::Pcm16 {
+            hound::SampleFormat::Int
+        } else {
+            hound::SampleFormat::Float
+        },
+    };
+    let mut clipped = 0;
+    {
+        let mut w = hound::WavWriter::new(BufWriter::new(tmp.as_file_mut()), spec).map_err(|e| fail(&e))?;
+        for f in 0..frames {
+            for c in channels {
+                let x = c[f] as f64 * g;
+                match format {
+                    WavFormat::Float32 => w.write_sample(x as f32),
+                    WavFormat::Pcm16 => {
+                        if x.abs() > 1.0 {
+                            clipped += 1;
+                        }
+                        w.write_sample((x.clamp(-1.0, 1.0) * 32767.0).round() as i16)
+                    }
+                }
+                .map_err(|e| fail(&e))?;
+            }
+        }
+        w.finalize().map_err(|e| fail(&e))?;
+    }
+    tmp.persist(path).map_err(|e| fail(&e.error))?;
+    Ok(WavReport {
+        channels: channels.len() as u16,
+        frames,
+        sample_rate,
+        gain: g,
+        peak: raw_peak * g,
+        clipped,
+    })
+}
