@@ -1,1 +1,39 @@
-//! modal-scene
+//! `modal-scene`: rigid-body scenes whose contacts strike mode banks.
+//!
+//! Input: a [`Scene`] (TOML, see `docs/scene-format.md`) and a
+//! [`BankProvider`] that supplies one [`modal_bank::ModeBank`] per distinct
+//! asset. Work: a rapier3d simulation whose bodies carry the banks' FEM mass
+//! properties; after every physics step each contact's impulse (normal and
+//! friction) strikes both bodies' modes at the contact point, with a Hertz
+//! contact time and a sub-step onset time. Output: audio channels (mono or
+//! stereo) heard at a listener with 1/r attenuation and r/c delay, a
+//! [`RenderReport`], optional impact events (JSON) and a spectrogram (PNG).
+
+mod error;
+mod excite;
+mod listener;
+mod material;
+mod physics;
+mod provider;
+mod render;
+mod spec;
+mod validate;
+
+pub use error::SceneError;
+pub use excite::{
+    hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_CONTACT_TIME_S, MIN_IMPULSE_NS,
+    SUSTAIN_DEADBAND,
+};
+pub use listener::{MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
+pub use material::{preset_names, resolve_material};
+pub use physics::ContactSide;
+pub use provider::{BankProvider, BankRequest, InMemoryProvider, ProviderError};
+pub use render::{
+    render, ObjectReport, RenderOptions, RenderReport, Rendered, AIR_IMPEDANCE_PA_S_M, FADE_OUT_S,
+    FULL_SCALE_PA, SILENCE_DB,
+};
+pub use spec::{
+    BodyKind, Channels, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec, MaterialSpec, MeshSource,
+    ObjectSpec, RotationSpec, Scene, DEMO_TOML, GENERATORS,
+};
+pub use validate::{MAX_DURATION_S, MAX_OBJECTS};

@@ -1,0 +1,367 @@
+//! The rapier3d world of a scene and what one step reports.
+//!
+//! Bodies: a dynamic object gets the **mass, centre of mass and inertia of
+//! its bank** (the tet mesh's exact integrals) as explicit mass properties;
+//! its collider is the convex hull of the bank's surface nodes with zero
+//! density, so the collider shape never changes the dynamics. A fixed object
+//! uses a triangle mesh of its surface. The body frame is the mesh frame, so
+//! contact points in collider coordinates are directly points of the bank's
+//! surface. The ground is a half-space `y ≥ height` pointing up.
+//!
+//! Stepping is single-threaded with a fixed `dt = 1/physics_rate` and the
+//! Coulomb friction model (one friction constraint per contact point), so the
+//! per-point friction impulse is meaningful and runs are bit-reproducible.
+
+use std::sync::Arc;
+
+use modal_bank::ModeBank;
+use modal_fem::Material;
+use rapier3d::prelude::*;
+
+use crate::material::{plane_strain_modulus, resolve_material};
+use crate::spec::{BodyKind, Scene};
+use crate::SceneError;
+
+/// `user_data` of the ground collider.
+const GROUND: u128 = u128::MAX;
+
+/// What the contact model needs to know about one side of a contact.
+#[derive(Clone, Debug)]
+pub struct ContactSide {
+    /// Object index, `None` for the ground.
+    pub object: Option<usize>,
+    /// `E/(1 − ν²)` [Pa].
+    pub plane_strain_pa: f64,
+    /// Mass [kg]; infinite for fixed bodies and the ground.
+    pub mass_kg: f64,
+    /// Hertz radius of curvature [m]; infinite for the ground.
+    pub radius_m: f64,
+}
+
+/// One contact point with a non-zero impulse after a step.
+#[derive(Clone, Debug)]
+pub(crate) struct ContactPoint {
+    /// Contact point on side 1, world frame [m].
+    pub world_m: [f64; 3],
+    /// Contact point in each body's (mesh) frame [m].
+    pub local_m: [[f64; 3]; 2],
+    /// Impulse applied to side 1 during the step, world frame [N·s]
+    /// (side 2 receives the opposite).
+    pub impulse_on_1: [f64; 3],
+    /// Normal part of the impulse, ≥ 0 [N·s].
+    pub normal_impulse: f64,
+    /// Signed separation at the start of the step [m].
+    pub separation_m: f64,
+    /// Normal approach speed at the start of the step [m/s] (> 0 closing).
+    pub approach_m_s: f64,
+}
+
+/// The touching points between two colliders after one step.
+#[derive(Clone, Debug)]
+pub(crate) struct PairContacts {
+    /// Stable key of the collider pair.
+    pub key: (u32, u32),
+    /// Side indices into [`World::sides`].
+    pub sides: [usize; 2],
+    /// Points with an impulse.
+    pub points: Vec<ContactPoint>,
+}
+
+/// The rapier world plus the bookkeeping that maps colliders to objects.
+pub(crate) struct World {
+    world: PhysicsWorld,
+    /// Per object: its body.
+    bodies: Vec<RigidBodyHandle>,
+    /// Contact sides: objects `0..n`, then the ground at index `n` if any.
+    pub sides: Vec<ContactSide>,
+    /// Pre-step velocity state of each object: (linvel, angvel, world com).
+    pre_step: Vec<([f64; 3], [f64; 3], [f64; 3])>,
+    gravity: [f64; 3],
+}
+
+fn v3(a: [f64; 3]) -> Vector {
+    Vector::new(a[0] as f32, a[1] as f32, a[2] as f32)
+}
+
+fn d3(v: Vector) -> [f64; 3] {
+    [v.x as f64, v.y as f64, v.z as f64]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Rotates `v` by the unit quaternion `q = [w, x, y, z]`.
+pub(crate) fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let u = [q[1], q[2], q[3]];
+    let t = cross(u, v).map(|x| 2.0 * x);
+    let c = cross(u, t);
+    [v[0] + q[0] * t[0] + c[0], v[1] + q[0] * t[1] + c[1], v[2] + q[0] * t[2] + c[2]]
+}
+
+/// Default Hertz radius: half the smallest bounding-box extent of the surface.
+fn default_contact_radius(bank: &ModeBank) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &bank.surface.positions {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    (0..3).map(|c| hi[c] - lo[c]).fold(f64::INFINITY, f64::min).max(1e-6) * 0.5
+}
+
+/// World position of every surface node of object `i` at its initial pose.
+pub(crate) fn initial_surface(scene: &Scene, i: usize, bank: &ModeBank) -> Vec<[f64; 3]> {
+    let o = &scene.objects[i];
+    let q = o.rotation.quaternion();
+    let com = bank.mass.center_of_mass_m;
+    bank.surface
+        .positions
+        .iter()
+        .map(|p| {
+            let r = rotate(q, sub(*p, com));
+            [r[0] + o.position_m[0], r[1] + o.position_m[1], r[2] + o.position_m[2]]
+        })
+        .collect()
+}
+
+/// Rejects objects that start below the ground plane.
+pub(crate) fn check_ground_clearance(scene: &Scene, banks: &[Arc<ModeBank>]) -> Result<(), SceneError> {
+    let Some(ground) = &scene.ground else { return Ok(()) };
+    for (i, bank) in banks.iter().enumerate() {
+        let lowest = initial_surface(scene, i, bank).iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        let depth = ground.height_m - lowest;
+        if depth > 1e-6 {
+            return Err(SceneError::invalid(
+                format!("objects[{i}].position"),
+                format!(
+                    "object '{}' intersects the ground: its lowest point is {:.4} m below y = {}",
+                    scene.object_name(i),
+                    depth,
+                    ground.height_m
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl World {
+    /// Builds bodies and colliders for all objects and the ground.
+    pub fn new(scene: &Scene, banks: &[Arc<ModeBank>]) -> Result<World, SceneError> {
+        let mut world = PhysicsWorld::new();
+        world.gravity = v3(scene.gravity_m_s2);
+        world.integration_parameters.dt = (1.0 / scene.physics_rate_hz) as f32;
+        world.integration_parameters.friction_model = FrictionModel::Coulomb;
+        let mut bodies = Vec::with_capacity(banks.len());
+        let mut sides = Vec::with_capacity(banks.len() + 1);
+        for (i, bank) in banks.iter().enumerate() {
+            let (handle, side) = add_object(&mut world, scene, i, bank)?;
+            bodies.push(handle);
+            sides.push(side);
+        }
+        if let Some(g) = &scene.ground {
+            let material: Material =
+                resolve_material(&g.material).map_err(|m| SceneError::invalid("ground.material", m))?;
+            let body = world.bodies.insert(RigidBodyBuilder::fixed().translation(v3([0.0, g.height_m, 0.0])));
+            let collider = ColliderBuilder::halfspace(rapier3d::na::Unit::new_unchecked(Vector::Y))
+                .friction(g.friction as f32)
+                .restitution(g.restitution as f32)
+                .friction_combine_rule(CoefficientCombineRule::Average)
+                .restitution_combine_rule(CoefficientCombineRule::Average)
+                .user_data(GROUND);
+            world.colliders.insert_with_parent(collider, body, &mut world.bodies);
+            sides.push(ContactSide {
+                object: None,
+                plane_strain_pa: plane_strain_modulus(&material),
+                mass_kg: f64::INFINITY,
+                radius_m: f64::INFINITY,
+            });
+        }
+        let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
+        Ok(World { world, bodies, sides, pre_step, gravity: scene.gravity_m_s2 })
+    }
+
+    /// World position of object `i`'s centre of mass [m].
+    pub fn center_of_mass(&self, i: usize) -> [f64; 3] {
+        d3(self.world.bodies[self.bodies[i]].center_of_mass())
+    }
+
+    /// Rotates a world vector into object `i`'s mesh frame (current pose).
+    pub fn to_body(&self, i: usize, v: [f64; 3]) -> [f64; 3] {
+        let r = self.world.bodies[self.bodies[i]].rotation();
+        let q = [r.w as f64, -r.x as f64, -r.y as f64, -r.z as f64];
+        rotate(q, v)
+    }
+
+    /// True when no dynamic body is awake.
+    pub fn all_asleep(&self) -> bool {
+        self.world.bodies.iter().all(|(_, b)| !b.is_dynamic() || b.is_sleeping())
+    }
+
+    /// Advances by one step.
+    pub fn step(&mut self) {
+        for (i, h) in self.bodies.iter().enumerate() {
+            let b = &self.world.bodies[*h];
+            self.pre_step[i] = (d3(b.linvel()), d3(b.angvel()), d3(b.center_of_mass()));
+        }
+        self.world.step();
+    }
+
+    /// Every contact point that carried an impulse in the last step, pairs in
+    /// the narrow phase's (deterministic) order.
+    pub fn contacts(&self, out: &mut Vec<PairContacts>) {
+        out.clear();
+        let dt = self.world.integration_parameters.dt as f64;
+        for pair in self.world.narrow_phase.contact_pairs() {
+            let (Some(c1), Some(c2)) =
+                (self.world.colliders.get(pair.collider1), self.world.colliders.get(pair.collider2))
+            else {
+                continue;
+            };
+            let sides = [self.side_of(c1.user_data), self.side_of(c2.user_data)];
+            let mut points = Vec::new();
+            for m in pair.solver_manifolds() {
+                let n = d3(m.data.normal);
+                for p in &m.points {
+                    let jn = p.data.impulse as f64;
+                    if jn <= 0.0 || !jn.is_finite() {
+                        continue;
+                    }
+                    let world_m = d3(c1.position().transform_point(p.local_p1));
+                    let friction = friction_world(&p.data, n);
+                    // The solver pushes body 1 away from body 2, i.e. along −n.
+                    let impulse_on_1 =
+                        [-jn * n[0] + friction[0], -jn * n[1] + friction[1], -jn * n[2] + friction[2]];
+                    let approach = self.approach_speed(sides, world_m, n, dt);
+                    points.push(ContactPoint {
+                        world_m,
+                        local_m: [d3(p.local_p1), d3(p.local_p2)],
+                        impulse_on_1,
+                        normal_impulse: jn,
+                        separation_m: p.dist as f64,
+                        approach_m_s: approach,
+                    });
+                }
+            }
+            if !points.is_empty() {
+                let key = (pair.collider1.into_raw_parts().0, pair.collider2.into_raw_parts().0);
+                out.push(PairContacts { key, sides, points });
+            }
+        }
+    }
+
+    fn side_of(&self, user_data: u128) -> usize {
+        if user_data == GROUND {
+            self.sides.len() - 1
+        } else {
+            user_data as usize
+        }
+    }
+
+    /// Closing speed along `n` (from side 1 to side 2) at `p`, from the
+    /// velocities at the start of the step advanced by half a step of gravity.
+    fn approach_speed(&self, sides: [usize; 2], p: [f64; 3], n: [f64; 3], dt: f64) -> f64 {
+        let velocity = |side: usize| -> [f64; 3] {
+            let Some(i) = self.sides[side].object else { return [0.0; 3] };
+            if !self.sides[side].mass_kg.is_finite() {
+                return [0.0; 3];
+            }
+            let (v, w, c) = self.pre_step[i];
+            let r = cross(w, sub(p, c));
+            let g = self.gravity.map(|x| 0.5 * dt * x);
+            [v[0] + r[0] + g[0], v[1] + r[1] + g[1], v[2] + r[2] + g[2]]
+        };
+        let rel = sub(velocity(sides[1]), velocity(sides[0]));
+        (-dot(rel, n)).max(0.0)
+    }
+}
+
+/// World friction impulse on body 1 from the solver's tangent impulse.
+///
+/// The solver reports the step's total tangent impulse `T` in a tangent basis
+/// it does not expose, plus the last sub-step's impulse `w` both in that basis
+/// and as a world vector `W = w₁ t₁ + w₂ t₂`. Reading the tangent plane as the
+/// complex plane with `t₂ = n × t₁`, `W = w·t₁`, so the world total is
+/// `(T / w) · W`: `W` rotated by `arg T − arg w` about `n` and scaled by |T|/|w|.
+fn friction_world(data: &ContactData, n: [f64; 3]) -> [f64; 3] {
+    let t = (data.tangent_impulse.x as f64, data.tangent_impulse.y as f64);
+    let w = (data.warmstart_tangent_impulse.x as f64, data.warmstart_tangent_impulse.y as f64);
+    let ww = d3(data.warmstart_tangent_world);
+    let w2 = w.0 * w.0 + w.1 * w.1;
+    if w2 < 1e-30 || !(t.0.is_finite() && t.1.is_finite()) {
+        return [0.0; 3];
+    }
+    // z = T / w as a complex number.
+    let z = ((t.0 * w.0 + t.1 * w.1) / w2, (t.1 * w.0 - t.0 * w.1) / w2);
+    let nw = cross(n, ww);
+    [z.0 * ww[0] + z.1 * nw[0], z.0 * ww[1] + z.1 * nw[1], z.0 * ww[2] + z.1 * nw[2]]
+}
+
+fn add_object(
+    world: &mut PhysicsWorld,
+    scene: &Scene,
+    i: usize,
+    bank: &ModeBank,
+) -> Result<(RigidBodyHandle, ContactSide), SceneError> {
+    let o = &scene.objects[i];
+    let path = format!("objects[{i}]");
+    let q = o.rotation.quaternion();
+    let com = bank.mass.center_of_mass_m;
+    let rc = rotate(q, com);
+    let origin = [o.position_m[0] - rc[0], o.position_m[1] - rc[1], o.position_m[2] - rc[2]];
+    let rotation = Rotation::from_xyzw(q[1] as f32, q[2] as f32, q[3] as f32, q[0] as f32).normalize();
+    let pose = Pose::from_parts(v3(origin), rotation);
+    let points: Vec<Vector> = bank.surface.positions.iter().map(|p| v3(*p)).collect();
+    let material = &bank.material;
+    let dynamic = o.body == BodyKind::Dynamic;
+    let builder = if dynamic {
+        let inertia = bank.mass.inertia_kg_m2;
+        let m = Matrix::from_cols_array_2d(&inertia.map(|r| r.map(|x| x as f32)));
+        let props = MassProperties::with_inertia_matrix(v3(com), bank.mass.mass_kg as f32, m);
+        RigidBodyBuilder::dynamic()
+            .pose(pose)
+            .linvel(v3(o.linear_velocity_m_s))
+            .angvel(v3(o.angular_velocity_rad_s))
+            .additional_mass_properties(props)
+            .ccd_enabled(true)
+    } else {
+        RigidBodyBuilder::fixed().pose(pose)
+    };
+    let collider = if dynamic {
+        ColliderBuilder::convex_hull(&points).ok_or_else(|| SceneError::Collider {
+            path: path.clone(),
+            message: "degenerate convex hull".into(),
+        })?
+    } else {
+        let tris: Vec<[u32; 3]> = bank.surface.triangles.iter().map(|t| t.map(|k| k as u32)).collect();
+        ColliderBuilder::trimesh(points, tris)
+            .map_err(|e| SceneError::Collider { path: path.clone(), message: format!("{e:?}") })?
+    };
+    let collider = collider
+        .density(0.0)
+        .friction(o.friction as f32)
+        .restitution(o.restitution as f32)
+        .friction_combine_rule(CoefficientCombineRule::Average)
+        .restitution_combine_rule(CoefficientCombineRule::Average)
+        .user_data(i as u128);
+    let handle = world.bodies.insert(builder);
+    world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
+    let side = ContactSide {
+        object: Some(i),
+        plane_strain_pa: plane_strain_modulus(material),
+        mass_kg: if dynamic { bank.mass.mass_kg } else { f64::INFINITY },
+        radius_m: o.contact_radius_m.unwrap_or_else(|| default_contact_radius(bank)),
+    };
+    Ok((handle, side))
+}

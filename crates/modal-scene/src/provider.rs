@@ -1,0 +1,157 @@
+//! Where mode banks come from. The scene never solves eigenproblems: it asks a
+//! [`BankProvider`] once per distinct asset ([`BankRequest`]) and shares the
+//! returned bank among all instances.
+
+use std::sync::Arc;
+
+use modal_bank::ModeBank;
+use modal_fem::Material;
+
+use crate::material::resolve_material;
+use crate::spec::{MeshSource, ObjectSpec, Scene};
+use crate::SceneError;
+
+/// What to solve or load: everything that changes a bank, nothing that does
+/// not (pose, velocity, name). Two objects with equal requests share a bank.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BankRequest {
+    /// A mesh to precompute (file path already resolved against the scene
+    /// file, or a generator recipe) ...
+    pub mesh: Option<MeshSource>,
+    /// ... or an existing bank file.
+    pub bank: Option<std::path::PathBuf>,
+    /// Material; `None` only for a bank used as stored.
+    pub material: Option<Material>,
+    /// Element order 1 or 2, `None` = provider default.
+    pub order: Option<u8>,
+    /// Uniform geometric scale of the mesh.
+    pub scale: f64,
+    /// Highest frequency worth solving for [Hz]: the scene's Nyquist frequency.
+    pub max_frequency_hz: f64,
+}
+
+impl BankRequest {
+    /// The request behind object `object` of `scene`.
+    pub fn for_object(scene: &Scene, object: &ObjectSpec) -> Result<BankRequest, String> {
+        let material = object.material.as_ref().map(resolve_material).transpose()?;
+        Ok(BankRequest {
+            mesh: object.mesh.clone(),
+            bank: object.bank.clone(),
+            material,
+            order: object.order,
+            scale: object.scale,
+            max_frequency_hz: 0.5 * scene.sample_rate_hz as f64,
+        })
+    }
+}
+
+/// The provider's error type: anything printable.
+pub type ProviderError = Box<dyn std::error::Error + Send + Sync>;
+
+/// Supplies mode banks (precompute + cache in the application, in-memory
+/// banks in tests). The bank's `mass` and `surface` define the rigid body;
+/// its `material` is used for Hertz contact.
+pub trait BankProvider {
+    /// The bank for one distinct asset. Called at most once per distinct
+    /// request during a render.
+    fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError>;
+}
+
+/// A provider serving fixed banks by generator name or file name, for tests
+/// and embedding: a request matches an entry whose key equals the generator
+/// name (`mesh = { generate = KEY }`) or the file name of `mesh`/`bank`.
+#[derive(Default)]
+pub struct InMemoryProvider {
+    entries: Vec<(String, Arc<ModeBank>)>,
+    /// Requests served so far, in order.
+    pub requests: Vec<BankRequest>,
+}
+
+impl InMemoryProvider {
+    /// An empty provider.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Serves `bank` for requests with key `key`.
+    pub fn insert(&mut self, key: impl Into<String>, bank: ModeBank) -> &mut Self {
+        self.entries.push((key.into(), Arc::new(bank)));
+        self
+    }
+
+    fn key(request: &BankRequest) -> Option<String> {
+        match (&request.mesh, &request.bank) {
+            (Some(MeshSource::Generate(g)), _) => Some(g.generate.clone()),
+            (Some(MeshSource::File(p)), _) | (None, Some(p)) => {
+                p.file_name().map(|n| n.to_string_lossy().into_owned())
+            }
+            (None, None) => None,
+        }
+    }
+}
+
+impl BankProvider for InMemoryProvider {
+    fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError> {
+        self.requests.push(request.clone());
+        let key = Self::key(request).ok_or("request names no asset")?;
+        self.entries
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, b)| Arc::clone(b))
+            .ok_or_else(|| format!("no in-memory bank named '{key}'").into())
+    }
+}
+
+/// Asks the provider once per distinct request; returns one bank per object.
+pub(crate) fn resolve_banks(
+    scene: &Scene,
+    provider: &mut dyn BankProvider,
+) -> Result<Vec<Arc<ModeBank>>, SceneError> {
+    let mut distinct: Vec<(BankRequest, Arc<ModeBank>)> = Vec::new();
+    let mut banks = Vec::with_capacity(scene.objects.len());
+    for (i, object) in scene.objects.iter().enumerate() {
+        let path = format!("objects[{i}]");
+        let request = BankRequest::for_object(scene, object)
+            .map_err(|m| SceneError::invalid(format!("{path}.material"), m))?;
+        if let Some((_, bank)) = distinct.iter().find(|(r, _)| *r == request) {
+            banks.push(Arc::clone(bank));
+            continue;
+        }
+        let bank =
+            provider.bank(&request).map_err(|source| SceneError::Bank { path: path.clone(), source })?;
+        check_bank(&path, &bank)?;
+        distinct.push((request, Arc::clone(&bank)));
+        banks.push(bank);
+    }
+    Ok(banks)
+}
+
+/// The scene relies on a bank's surface and mass properties; reject banks it
+/// cannot use instead of panicking later.
+fn check_bank(path: &str, bank: &ModeBank) -> Result<(), SceneError> {
+    let bad = |m: &str| Err(SceneError::invalid(path, format!("unusable bank: {m}")));
+    let n = bank.surface.positions.len();
+    if n < 4 || bank.surface.triangles.is_empty() {
+        return bad("its surface has fewer than 4 nodes or no triangles");
+    }
+    if bank.surface.triangles.iter().flatten().any(|&k| k >= n) {
+        return bad("a surface triangle refers to a missing node");
+    }
+    if bank.surface.positions.iter().flatten().any(|x| !x.is_finite()) {
+        return bad("a surface position is not finite");
+    }
+    let m = &bank.mass;
+    if !(m.mass_kg.is_finite() && m.mass_kg > 0.0) {
+        return bad("its mass is not positive");
+    }
+    if m.center_of_mass_m.iter().chain(m.inertia_kg_m2.iter().flatten()).any(|x| !x.is_finite()) {
+        return bad("its centre of mass or inertia is not finite");
+    }
+    if bank.shapes.len() != bank.mode_count() * n * 3
+        || bank.decay_rates.len() != bank.mode_count()
+        || bank.damping_ratios.len() != bank.mode_count()
+    {
+        return bad("its arrays disagree in length");
+    }
+    Ok(())
+}

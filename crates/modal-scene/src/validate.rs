@@ -1,0 +1,156 @@
+//! Checks a parsed scene before any work: ranges, finiteness, exclusive keys,
+//! materials and files. Every error names its key path.
+
+use crate::material::resolve_material;
+use crate::spec::{MeshSource, ObjectSpec, RotationSpec, Scene};
+use crate::SceneError;
+
+/// Longest scene accepted [s] (guards against giant allocations).
+pub const MAX_DURATION_S: f64 = 3600.0;
+/// Most objects accepted in one scene.
+pub const MAX_OBJECTS: usize = 100_000;
+
+pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
+    positive("duration", scene.duration_s)?;
+    if scene.duration_s > MAX_DURATION_S {
+        return Err(SceneError::invalid(
+            "duration",
+            format!("at most {MAX_DURATION_S} s, got {}", scene.duration_s),
+        ));
+    }
+    if !(8_000..=192_000).contains(&scene.sample_rate_hz) {
+        return Err(SceneError::invalid(
+            "sample_rate",
+            format!("must lie in 8000..=192000 Hz, got {}", scene.sample_rate_hz),
+        ));
+    }
+    positive("physics_rate", scene.physics_rate_hz)?;
+    if !(30.0..=20_000.0).contains(&scene.physics_rate_hz) {
+        return Err(SceneError::invalid(
+            "physics_rate",
+            format!("must lie in 30..=20000 Hz, got {}", scene.physics_rate_hz),
+        ));
+    }
+    finite3("gravity", scene.gravity_m_s2)?;
+    let l = &scene.listener;
+    finite3("listener.position", l.position_m)?;
+    non_negative("listener.ear_spacing", l.ear_spacing_m)?;
+    nonzero3("listener.right", l.right)?;
+    non_negative("listener.gain", l.gain)?;
+    if let Some(g) = &scene.ground {
+        finite("ground.height", g.height_m)?;
+        resolve_material(&g.material).map_err(|m| SceneError::invalid("ground.material", m))?;
+        non_negative("ground.friction", g.friction)?;
+        unit_interval("ground.restitution", g.restitution)?;
+    }
+    if scene.objects.len() > MAX_OBJECTS {
+        return Err(SceneError::invalid("objects", format!("at most {MAX_OBJECTS} objects")));
+    }
+    for (i, object) in scene.objects.iter().enumerate() {
+        validate_object(&format!("objects[{i}]"), object)?;
+    }
+    Ok(())
+}
+
+fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
+    let key = |k: &str| format!("{at}.{k}");
+    match (&o.mesh, &o.bank) {
+        (Some(_), Some(_)) => return Err(SceneError::invalid(at, "give either `mesh` or `bank`, not both")),
+        (None, None) => return Err(SceneError::invalid(at, "needs a `mesh` or a `bank`")),
+        (Some(MeshSource::File(p)), None) | (None, Some(p)) => {
+            let k = if o.mesh.is_some() { key("mesh") } else { key("bank") };
+            if !p.is_file() {
+                return Err(SceneError::invalid(k, format!("file not found: {}", p.display())));
+            }
+        }
+        (Some(MeshSource::Generate(g)), None) => {
+            g.shape().map_err(|m| SceneError::invalid(key("mesh"), m))?;
+            let lengths = [g.radius, g.inner_radius, g.length, g.thickness, g.element_size];
+            let names = ["radius", "inner_radius", "length", "thickness", "element_size"];
+            for (v, n) in lengths.iter().zip(names) {
+                if let Some(v) = v {
+                    positive(&key(&format!("mesh.{n}")), *v)?;
+                }
+            }
+            if let Some(size) = g.size {
+                for (c, v) in size.iter().enumerate() {
+                    positive(&key(&format!("mesh.size[{c}]")), *v)?;
+                }
+            }
+        }
+    }
+    match &o.material {
+        Some(m) => {
+            resolve_material(m).map_err(|msg| SceneError::invalid(key("material"), msg))?;
+        }
+        None if o.mesh.is_some() => return Err(SceneError::invalid(key("material"), "required with `mesh`")),
+        None => {}
+    }
+    if o.order.is_some_and(|n| n != 1 && n != 2) {
+        return Err(SceneError::invalid(key("order"), "must be 1 or 2"));
+    }
+    positive(&key("scale"), o.scale)?;
+    finite3(&key("position"), o.position_m)?;
+    match &o.rotation {
+        RotationSpec::AxisAngle { axis, angle } => {
+            nonzero3(&key("rotation.axis"), *axis)?;
+            finite(&key("rotation.angle"), *angle)?;
+        }
+        RotationSpec::Euler { euler } => finite3(&key("rotation.euler"), *euler)?,
+    }
+    finite3(&key("linear_velocity"), o.linear_velocity_m_s)?;
+    finite3(&key("angular_velocity"), o.angular_velocity_rad_s)?;
+    non_negative(&key("friction"), o.friction)?;
+    unit_interval(&key("restitution"), o.restitution)?;
+    if let Some(r) = o.contact_radius_m {
+        positive(&key("contact_radius"), r)?;
+    }
+    Ok(())
+}
+
+fn finite(path: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be a finite number, got {v}")))
+    }
+}
+
+fn finite3(path: &str, v: [f64; 3]) -> Result<(), SceneError> {
+    for (c, x) in v.iter().enumerate() {
+        finite(&format!("{path}[{c}]"), *x)?;
+    }
+    Ok(())
+}
+
+fn nonzero3(path: &str, v: [f64; 3]) -> Result<(), SceneError> {
+    finite3(path, v)?;
+    if v.iter().all(|x| *x == 0.0) {
+        return Err(SceneError::invalid(path, "must not be the zero vector"));
+    }
+    Ok(())
+}
+
+fn positive(path: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be finite and > 0, got {v}")))
+    }
+}
+
+fn non_negative(path: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be finite and >= 0, got {v}")))
+    }
+}
+
+fn unit_interval(path: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must lie in [0, 1], got {v}")))
+    }
+}

@@ -1,0 +1,63 @@
+//! Issue 5 acceptance: a ball dropped on the floor — onset time, silence at
+//! rest, louder when thrown harder.
+
+mod common;
+
+use std::path::Path;
+
+use modal_scene::{render, InMemoryProvider, RenderOptions, Scene};
+
+const R: f64 = 0.02;
+
+fn drop_scene(clearance: f64, vy: f64, duration: f64, listener: [f64; 3]) -> Scene {
+    let text = format!(
+        r#"
+duration = {duration}
+sample_rate = 16000
+physics_rate = 1000
+[listener]
+position = [{}, {}, {}]
+channels = "mono"
+[ground]
+material = "wood"
+restitution = 0.0
+[[objects]]
+name = "ball"
+mesh = {{ generate = "sphere", radius = {R} }}
+material = "steel"
+position = [0.0, {}, 0.0]
+linear_velocity = [0.0, {vy}, 0.0]
+restitution = 0.0
+"#,
+        listener[0],
+        listener[1],
+        listener[2],
+        R + clearance
+    );
+    Scene::from_toml_str(&text, Path::new(".")).expect("scene")
+}
+
+fn provider() -> InMemoryProvider {
+    let mut p = InMemoryProvider::new();
+    p.insert("sphere", common::ball(R, &[1500.0, 3100.0, 4700.0]));
+    p
+}
+
+#[test]
+fn drop_onset_is_free_fall_time_plus_propagation() {
+    let h = 0.1;
+    let listener = [0.0, 0.5, 1.0];
+    let scene = drop_scene(h, 0.0, 0.4, listener);
+    let out = render(&scene, &mut provider(), &RenderOptions { collect_events: true }).expect("render");
+    let y = &out.channels[0];
+    let fs = scene.sample_rate_hz as f64;
+    let t_onset = common::onset(y, 1e-3).expect("sound") as f64 / fs;
+    let contact = [0.0, R, 0.0];
+    let r = ((listener[0] - contact[0]).powi(2)
+        + (listener[1] - contact[1]).powi(2)
+        + (listener[2] - contact[2]).powi(2))
+    .sqrt();
+    let expected = (2.0 * h / 9.81).sqrt() + r / 343.0;
+    eprintln!("onset {t_onset} expected {expected} events {:?}", &out.events[..out.events.len().min(3)]);
+    assert!((t_onset - expected).abs() < 1e-3, "onset {t_onset} s, expected {expected} s");
+}
