@@ -10,6 +10,7 @@ mod mesh;
 mod output;
 mod precompute;
 mod progress;
+mod render;
 mod strike;
 
 use std::path::Path;
@@ -34,7 +35,7 @@ pub fn run() -> ExitCode {
 
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        None => anyhow::bail!("the demo scene is not wired up yet"),
+        None => render::run(args::RenderArgs::default()),
         Some(Command::Precompute(args)) => precompute::run(args),
         Some(Command::ExportMatrices(args)) => precompute::export_matrices(args),
         Some(Command::Info(args)) => bank_cmds::info(args),
@@ -42,7 +43,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Export(args)) => bank_cmds::export(args),
         Some(Command::Mesh(args)) => mesh::run(args.shape),
         Some(Command::Strike(args)) => strike::run(args),
-        Some(_) => anyhow::bail!("not implemented yet"),
+        Some(Command::Render(args)) => render::run(args),
     }
 }
 

@@ -1,0 +1,198 @@
+//! `modal render` (and `modal` with no arguments): simulate a rigid-body
+//! scene and write what its listener hears.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::{Context, Result};
+use modal_bank::{BankCache, ModeBank};
+use modal_precompute::{MeshSource, Request};
+use modal_scene::{BankProvider, BankRequest, ProviderError, Scene};
+use modal_synth::{WavFormat, WavGain};
+
+use super::args::RenderArgs;
+use super::output::{print_json, warn};
+use super::precompute::open_cache;
+use super::progress::Spinner;
+use super::write_atomic;
+
+/// Where the demo is written when no output is given.
+pub const DEMO_OUTPUT: &str = "audio_out/demo.wav";
+/// Element size of generated meshes without `element_size`: this fraction of
+/// the shape's smallest dimension.
+const DEFAULT_ELEMENTS_PER_SMALLEST_DIMENSION: f64 = 3.0;
+
+/// Serves scene objects' banks through the precompute pipeline and its cache.
+struct PipelineProvider<'a> {
+    cache: Option<BankCache>,
+    spinner: &'a Spinner,
+    threads: Option<usize>,
+    /// Warnings to print once the spinner is gone.
+    warnings: Vec<String>,
+    /// Assets served from the cache and solved fresh.
+    cached: usize,
+    solved: usize,
+}
+
+impl BankProvider for PipelineProvider<'_> {
+    fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError> {
+        if let Some(path) = &request.bank {
+            return Ok(Arc::new(ModeBank::load(path)?));
+        }
+        let mesh = request.mesh.as_ref().ok_or("the object names neither a mesh nor a bank")?;
+        let material = request.material.clone().ok_or("an object given as a mesh needs a material")?;
+        let source = match mesh {
+            modal_scene::MeshSource::File(path) => MeshSource::File(path.clone()),
+            modal_scene::MeshSource::Generate(spec) => {
+                let shape = spec.shape()?;
+                let h = spec
+                    .element_size
+                    .unwrap_or_else(|| smallest_dimension(&shape) / DEFAULT_ELEMENTS_PER_SMALLEST_DIMENSION);
+                // Linear here; the pipeline promotes to the requested order.
+                let mesh = modal_mesh::generate::generate(&shape, h, 1)?;
+                MeshSource::Memory { mesh, identity: format!("generated {shape:?} h={h:e}") }
+            }
+        };
+        let mut pipeline = Request::new(source, material);
+        pipeline.scale = request.scale;
+        pipeline.order = request.order.unwrap_or(2);
+        // No modes above the scene's Nyquist frequency are worth solving for.
+        pipeline.max_freq_hz = request.max_frequency_hz;
+        pipeline.threads = self.threads;
+        let what = describe(mesh);
+        self.spinner.set(format!("mode bank for {what}"));
+        let outcome = modal_precompute::precompute(&pipeline, self.cache.as_ref(), false, &mut |_| {})
+            .map_err(|e| format!("{what}: {e}"))?;
+        self.warnings.extend(outcome.warnings.into_iter().map(|w| format!("{what}: {w}")));
+        if outcome.cached {
+            self.cached += 1;
+        } else {
+            self.solved += 1;
+        }
+        Ok(Arc::new(outcome.bank))
+    }
+}
+
+fn describe(mesh: &modal_scene::MeshSource) -> String {
+    match mesh {
+        modal_scene::MeshSource::File(path) => path.display().to_string(),
+        modal_scene::MeshSource::Generate(spec) => format!("generated {}", spec.generate),
+    }
+}
+
+fn smallest_dimension(shape: &modal_mesh::generate::Shape) -> f64 {
+    use modal_mesh::generate::Shape;
+    match *shape {
+        Shape::Box { size } => size.iter().copied().fold(f64::INFINITY, f64::min),
+        Shape::Cylinder { radius, length } => (2.0 * radius).min(length),
+        Shape::Tube { inner_radius, outer_radius, length } => (outer_radius - inner_radius).min(length),
+        Shape::Sphere { radius } => 2.0 * radius,
+        Shape::Bowl { thickness, .. } => thickness,
+    }
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let (scene, default_out) = match &args.scene {
+        Some(path) => {
+            let scene = Scene::from_file(path).with_context(|| format!("scene {}", path.display()))?;
+            let out = scene.output.clone().unwrap_or_else(|| path.with_extension("wav"));
+            (scene, out)
+        }
+        None => (Scene::demo(), PathBuf::from(DEMO_OUTPUT)),
+    };
+    let out = args.out.clone().unwrap_or(default_out);
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+    }
+    let spinner = Spinner::new("preparing the scene");
+    let mut provider = PipelineProvider {
+        cache: open_cache(args.cache_dir.as_deref(), false),
+        spinner: &spinner,
+        threads: args.threads,
+        warnings: Vec::new(),
+        cached: 0,
+        solved: 0,
+    };
+    let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
+    let rendered = modal_scene::render(&scene, &mut provider, &options);
+    spinner.set("writing");
+    let (warnings, cached, solved) =
+        (std::mem::take(&mut provider.warnings), provider.cached, provider.solved);
+    spinner.finish();
+    warnings.iter().for_each(|w| warn(w));
+    let rendered = rendered.context("render failed")?;
+    let channels: Vec<&[f32]> = rendered.channels.iter().map(Vec::as_slice).collect();
+    let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
+    let wav = modal_synth::write_wav(&out, &channels, rendered.sample_rate, format, WavGain::Fixed(1.0))
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    if wav.clipped > 0 {
+        warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
+    }
+    if let Some(path) = &args.events {
+        write_json_file(path, &rendered.events)?;
+    }
+    if let Some(path) = &args.spectrogram {
+        anyhow::bail!("--spectrogram {}: not available yet", path.display());
+    }
+    let report = &rendered.report;
+    if args.json {
+        let mut json = serde_json::to_value(report)?;
+        json["out"] = out.display().to_string().into();
+        json["banks_cached"] = cached.into();
+        json["banks_solved"] = solved.into();
+        json["real_time_factor"] = report.real_time_factor().into();
+        return print_json(&json);
+    }
+    print_report(report, &out, cached, solved);
+    Ok(())
+}
+
+fn write_json_file(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    write_atomic(path, |tmp| {
+        let file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        serde_json::to_writer_pretty(file, value)?;
+        Ok(())
+    })
+    .with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, solved: usize) {
+    println!(
+        "{:>16}  {:>7}  {:>7}  {:>12}  {:>14}  {:>12}",
+        "object", "impacts", "modes", "mode-samples", "samples", "peak Pa @1m"
+    );
+    for o in &report.objects {
+        println!(
+            "{:>16}  {:>7}  {:>3}/{:<3}  {:>12}  {:>14}  {:>12.3e}",
+            o.name,
+            o.impacts,
+            o.modes_synthesized,
+            o.modes_total,
+            o.mode_samples,
+            o.samples_computed,
+            o.peak_pa_at_1m
+        );
+    }
+    println!(
+        "banks: {} distinct ({} from cache, {} solved) in {:.2} s; physics {:.3} s ({} steps), excitation {:.3} s, \
+         synthesis {:.3} s, mix {:.3} s: {:.0}x real time",
+        report.banks_requested,
+        cached,
+        solved,
+        report.banks_s,
+        report.physics_s,
+        report.physics_steps,
+        report.excitation_s,
+        report.synthesis_s,
+        report.mix_s,
+        report.real_time_factor()
+    );
+    println!(
+        "wrote {} ({:.2} s at {} Hz, {} impacts, peak {:.3} of full scale)",
+        out.display(),
+        report.duration_s,
+        report.sample_rate,
+        report.impacts,
+        report.peak
+    );
+}
