@@ -11,9 +11,11 @@
 //! `K − σM` can be formed entry by entry.
 //!
 //! Determinism: element matrices are computed in parallel (rayon) into
-//! per-element buffers, one chunk of elements at a time, then added to the
-//! global values serially in element order. Every global entry is therefore
-//! the same sum in the same order for any thread count: bit-identical results.
+//! per-element buffers, one chunk of elements at a time; then the global
+//! value array is split into disjoint column ranges and each range adds the
+//! chunk's contributions to its own columns in element order (also in
+//! parallel). Every global entry is therefore the same sum in the same order
+//! for any thread count: bit-identical results.
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use modal_mesh::TetMesh;
@@ -102,6 +104,27 @@ impl SparsityPattern {
         9 * start + 3 * cj * degree + 3 * k + ci
     }
 
+    /// Up to `parts` consecutive node ranges with about equal numbers of
+    /// stored entries, covering all nodes.
+    fn node_ranges(&self, parts: usize) -> Vec<(usize, usize)> {
+        let n_nodes = self.adj_ptr.len() - 1;
+        let total = self.adj_ptr[n_nodes];
+        let mut ranges = Vec::with_capacity(parts);
+        let mut start = 0;
+        for p in 1..=parts {
+            let goal = total * p / parts;
+            let mut end = start;
+            while end < n_nodes && (self.adj_ptr[end] < goal || p == parts) {
+                end += 1;
+            }
+            if end > start {
+                ranges.push((start, end));
+                start = end;
+            }
+        }
+        ranges
+    }
+
     /// Assembles K and M of `mesh` (same connectivity as the pattern) for
     /// `material` (validated here).
     pub fn assemble(&self, mesh: &TetMesh, material: &Material) -> Result<Assembly, FemError> {
@@ -140,12 +163,19 @@ impl SparsityPattern {
             if let Some(err) = failure {
                 return Err(err);
             }
-            for i in 0..count {
-                let nodes = mesh.cells.nodes_of(first + i);
-                let range = i * block..(i + 1) * block;
-                self.scatter(nodes, &k_buf[range.clone()], &mut k_val);
-                self.scatter(nodes, &m_buf[range], &mut m_val);
-            }
+            let ranges = self.node_ranges(SCATTER_RANGES);
+            let k_parts = split_by_ranges(&mut k_val, &ranges, &self.adj_ptr);
+            let m_parts = split_by_ranges(&mut m_val, &ranges, &self.adj_ptr);
+            k_parts.into_par_iter().zip(m_parts).zip(ranges.par_iter()).for_each(|((kv, mv), &(n0, n1))| {
+                let offset = 9 * self.adj_ptr[n0];
+                for i in 0..count {
+                    let nodes = mesh.cells.nodes_of(first + i);
+                    let range = i * block..(i + 1) * block;
+                    let target = ScatterTarget { columns: n0..n1, offset };
+                    self.scatter(nodes, &k_buf[range.clone()], kv, &target, false);
+                    self.scatter(nodes, &m_buf[range], mv, &target, true);
+                }
+            });
         }
         Ok(Assembly {
             k: SparseColMat::new(self.symbolic.clone(), k_val),
@@ -153,15 +183,33 @@ impl SparsityPattern {
         })
     }
 
-    /// Adds one element matrix (row-major, `3n × 3n`) into `values`.
-    fn scatter(&self, nodes: &[usize], element: &[f64], values: &mut [f64]) {
+    /// Adds one element matrix (row-major, `3n × 3n`) into `values`; with
+    /// `same_component_only` (mass matrices) only entries `ci == cj`, the
+    /// others being exactly zero.
+    /// Only columns of nodes in `target.columns` are written; `values` is
+    /// the slice of the global value array starting at `target.offset`.
+    fn scatter(
+        &self,
+        nodes: &[usize],
+        element: &[f64],
+        values: &mut [f64],
+        target: &ScatterTarget,
+        same_component_only: bool,
+    ) {
         let size = 3 * nodes.len();
         for (b, &nb) in nodes.iter().enumerate() {
+            if !target.columns.contains(&nb) {
+                continue;
+            }
             for (a, &na) in nodes.iter().enumerate() {
-                let base = self.position(na, nb, 0, 0);
+                let base = self.position(na, nb, 0, 0) - target.offset;
                 let degree = self.adj_ptr[nb + 1] - self.adj_ptr[nb];
                 for cj in 0..3 {
                     let col = base + 3 * cj * degree;
+                    if same_component_only {
+                        values[col + cj] += element[(3 * a + cj) * size + 3 * b + cj];
+                        continue;
+                    }
                     for ci in 0..3 {
                         values[col + ci] += element[(3 * a + ci) * size + 3 * b + cj];
                     }
@@ -169,6 +217,34 @@ impl SparsityPattern {
             }
         }
     }
+}
+
+/// Node ranges whose column blocks are scattered in parallel. Any count
+/// gives bit-identical sums (each entry is still summed in element order).
+const SCATTER_RANGES: usize = 16;
+
+/// The node columns one parallel scatter task owns, and where its slice of
+/// the global value array starts.
+struct ScatterTarget {
+    columns: std::ops::Range<usize>,
+    offset: usize,
+}
+
+/// Splits `values` into the disjoint slices of the column blocks of each
+/// node range.
+fn split_by_ranges<'a>(
+    values: &'a mut [f64],
+    ranges: &[(usize, usize)],
+    adj_ptr: &[usize],
+) -> Vec<&'a mut [f64]> {
+    let mut parts = Vec::with_capacity(ranges.len());
+    let mut rest = values;
+    for &(n0, n1) in ranges {
+        let (head, tail) = rest.split_at_mut(9 * (adj_ptr[n1] - adj_ptr[n0]));
+        parts.push(head);
+        rest = tail;
+    }
+    parts
 }
 
 /// Node coordinates of element `e` (first 4 or 10 entries used).

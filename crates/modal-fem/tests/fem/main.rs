@@ -6,6 +6,7 @@
 mod assembly;
 mod bar;
 mod common;
+mod cpu_time;
 mod mass;
 mod patch;
 mod reference;
