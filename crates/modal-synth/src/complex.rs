@@ -32,6 +32,11 @@ impl C64 {
         self.re.hypot(self.im)
     }
 
+    /// Squared modulus `|z|²`.
+    pub fn norm2(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+
     /// Product with a real number.
     pub fn scale(self, k: f64) -> C64 {
         C64::new(self.re * k, self.im * k)

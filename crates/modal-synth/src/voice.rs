@@ -146,6 +146,8 @@ struct Modes {
     pole: Vec<C64>,
     /// `e^{sB/fs}`.
     pole_block: Vec<C64>,
+    /// `|e^{sB/fs}|²`: energy decay over one block.
+    block_decay2: Vec<f64>,
     /// Output weight `W`.
     w: Vec<C64>,
     /// Weighted state at `t_anchor` (zero for inactive modes).
@@ -197,7 +199,11 @@ pub struct ModalVoice {
     events: Vec<Event>,
     seq: u64,
     stats: VoiceStats,
+    /// Scratch full-size state, zero between operations.
     cur: Vec<C64>,
+    /// Scratch candidate and kept index lists.
+    cand: Vec<usize>,
+    keep: Vec<usize>,
     modal: Vec<f64>,
     chunks: Vec<ChunkScratch>,
     seg64: Vec<f64>,
@@ -219,6 +225,7 @@ impl ModalVoice {
             s: vec![C64::ZERO; n],
             pole: vec![C64::ZERO; n],
             pole_block: vec![C64::ZERO; n],
+            block_decay2: vec![0.0; n],
             w: vec![C64::ZERO; n],
             anchor: vec![C64::ZERO; n],
             grid: vec![C64::ZERO; n],
@@ -243,6 +250,7 @@ impl ModalVoice {
             modes.s[i] = s;
             modes.pole[i] = s.scale(1.0 / fs).exp();
             modes.pole_block[i] = s.scale(BLOCK as f64 / fs).exp();
+            modes.block_decay2[i] = modes.pole_block[i].norm2();
         }
         let path = match opts.kernel {
             Kernel::Auto => Some(SimdPath::detect()),
@@ -265,6 +273,8 @@ impl ModalVoice {
             seq: 0,
             stats: VoiceStats { modes_total: n, modes_skipped: skipped, ..VoiceStats::default() },
             cur: vec![C64::ZERO; n],
+            cand: Vec::new(),
+            keep: Vec::new(),
             modal: vec![0.0; n],
             chunks: Vec::new(),
             seg64: Vec::new(),
@@ -471,13 +481,14 @@ impl ModalVoice {
                 self.cur[i] += c * self.modes.s[i].scale(dt).exp();
             }
         }
+        self.all_candidates();
         self.select_active(false);
         self.exact_next = true;
     }
 
-    /// Copies the kernel state of active modes into `cur` (others zero).
+    /// Copies the kernel state of active modes into `cur` (all other
+    /// entries of `cur` are zero between operations).
     fn scatter_current(&mut self) {
-        self.cur.iter_mut().for_each(|c| *c = C64::ZERO);
         let a = &self.active;
         for (k, &i) in a.idx.iter().enumerate() {
             self.cur[i] = if self.path.is_some() {
@@ -488,49 +499,61 @@ impl ModalVoice {
         }
     }
 
-    /// Chooses the active set from `cur` (amplitudes predicted one block
-    /// ahead when `block_ahead`), zeroes anchors of dropped modes and loads
-    /// the kernel arrays.
-    fn select_active(&mut self, block_ahead: bool) {
-        let n = self.model.mode_count();
-        let amp = |i: usize| {
-            let a = self.cur[i].abs();
-            if block_ahead {
-                a * self.modes.pole_block[i].abs()
-            } else {
-                a
+    /// Enabled modes whose `cur` or anchor is nonzero, ascending, into `self.cand`.
+    fn all_candidates(&mut self) {
+        self.cand.clear();
+        for i in 0..self.model.mode_count() {
+            if self.modes.enabled[i] && (self.cur[i] != C64::ZERO || self.modes.anchor[i] != C64::ZERO) {
+                self.cand.push(i);
             }
-        };
-        let loudest = (0..n).filter(|&i| self.modes.enabled[i]).map(amp).fold(0.0, f64::max);
-        let mut threshold = ABSOLUTE_FLOOR;
-        if let Some(db) = self.opts.cull_db {
-            threshold = threshold.max(loudest * 10f64.powf(db / 20.0));
         }
-        let mut keep: Vec<usize> = (0..n).filter(|&i| self.modes.enabled[i] && amp(i) >= threshold).collect();
+    }
+
+    /// Chooses the active set among `self.cand` (ascending; the only modes
+    /// whose `cur` may be nonzero) from `|cur|`, predicted one block ahead
+    /// when `block_ahead`; zeroes the anchors of dropped modes, loads the
+    /// kernel arrays and clears `cur` again.
+    fn select_active(&mut self, block_ahead: bool) {
+        let cand = std::mem::take(&mut self.cand);
+        let modes = &self.modes;
+        let cur = &self.cur;
+        let amp2 = |i: usize| cur[i].norm2() * if block_ahead { modes.block_decay2[i] } else { 1.0 };
+        let loudest2 = cand.iter().map(|&i| amp2(i)).fold(0.0, f64::max);
+        let mut threshold2 = ABSOLUTE_FLOOR * ABSOLUTE_FLOOR;
+        if let Some(db) = self.opts.cull_db {
+            threshold2 = threshold2.max(loudest2 * 10f64.powf(db / 10.0));
+        }
+        let mut keep = std::mem::take(&mut self.keep);
+        keep.clear();
+        keep.extend(cand.iter().copied().filter(|&i| amp2(i) >= threshold2));
         if let Some(b) = self.opts.budget {
             if keep.len() > b {
-                keep.sort_by(|&x, &y| amp(y).total_cmp(&amp(x)).then(x.cmp(&y)));
+                keep.sort_by(|&x, &y| amp2(y).total_cmp(&amp2(x)).then(x.cmp(&y)));
                 keep.truncate(b);
                 keep.sort_unstable();
             }
         }
-        // Zero the anchors of every mode not kept.
+        // Drop (zero the anchors of) every candidate not kept.
         let mut kept = keep.iter().peekable();
-        let mut dropped = 0u64;
-        for i in 0..n {
+        for &i in &cand {
             if kept.peek() == Some(&&i) {
                 kept.next();
-            } else if self.modes.anchor[i] != C64::ZERO || self.cur[i] != C64::ZERO {
+            } else if self.modes.anchor[i] != C64::ZERO {
                 self.modes.anchor[i] = C64::ZERO;
                 self.modes.grid[i] = C64::ZERO;
-                dropped += 1;
+                self.stats.modes_culled += 1;
             }
         }
-        self.stats.modes_culled += dropped;
         self.load_active(keep);
+        for &i in &cand {
+            self.cur[i] = C64::ZERO;
+        }
+        self.cand = cand;
     }
 
     fn load_active(&mut self, idx: Vec<usize>) {
+        let old = std::mem::take(&mut self.active.idx);
+        self.keep = old;
         let padded = idx.len().div_ceil(TILE) * TILE;
         let a = &mut self.active;
         for v in [&mut a.r32, &mut a.i32, &mut a.pr32, &mut a.pi32] {
@@ -562,7 +585,8 @@ impl ModalVoice {
         self.blocks_since_exact += 1;
         let exact = self.exact_next || self.blocks_since_exact >= REANCHOR_BLOCKS;
         let t = g as f64 / self.fs;
-        self.cur.iter_mut().for_each(|c| *c = C64::ZERO);
+        self.cand.clear();
+        self.cand.extend_from_slice(&self.active.idx);
         for &i in &self.active.idx {
             let u = if exact {
                 self.modes.anchor[i] * self.modes.s[i].scale(t - self.t_anchor).exp()
@@ -606,6 +630,7 @@ impl ModalVoice {
             let a = self.modes.anchor[i];
             self.cur[i] = if a == C64::ZERO { a } else { a * self.modes.s[i].scale(t).exp() };
         }
+        self.all_candidates();
         self.select_active(false);
         self.exact_next = true;
         self.synced = None;
@@ -703,6 +728,7 @@ impl ModalVoice {
         self.scatter_current();
         for &i in &self.active.idx {
             terms.push((t_now, -self.modes.s[i].re, self.cur[i].abs()));
+            self.cur[i] = C64::ZERO;
         }
         let events = self.events.clone();
         for ev in &events {
