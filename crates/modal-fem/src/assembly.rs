@@ -127,6 +127,10 @@ impl SparsityPattern {
 
     /// Assembles K and M of `mesh` (same connectivity as the pattern) for
     /// `material` (validated here).
+    ///
+    /// # Panics
+    /// If `mesh` has another element order, element count or node count
+    /// than the mesh the pattern was built from (a broken contract).
     pub fn assemble(&self, mesh: &TetMesh, material: &Material) -> Result<Assembly, FemError> {
         material.validate()?;
         assert!(

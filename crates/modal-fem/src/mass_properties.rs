@@ -35,6 +35,10 @@ pub struct MassProperties {
 
 /// Mass properties of `mesh` (4- or 10-node tets) with uniform density
 /// `density_kg_m3`. An empty mesh gives all zeros.
+///
+/// # Panics
+/// If an element refers to a node index out of range (check the mesh with
+/// `modal-mesh` first; [`crate::assemble`] reports this as an error).
 pub fn mass_properties(mesh: &TetMesh, density_kg_m3: f64) -> MassProperties {
     let n = mesh.node_count().max(1) as f64;
     let mut origin = [0.0; 3];

@@ -14,10 +14,11 @@
 //! - degree 3: 8 points with positive weights, derived here from the symmetric
 //!   moment equations: the 4 vertices (weight 1/240) and the 4 face centroids
 //!   (weight 3/80). Exactness: Σw = 1/6, ∫L₀² = 1/60, ∫L₀³ = 1/120 hold.
-//! - degree 5: 14 points with positive weights (Walkington 2000, "Quadrature
-//!   on simplices of arbitrary dimension"; the same rule as Keast 1986 #6
-//!   without its negative weights): two orbits `(a, a, a, 1 − 3a)` and one
-//!   orbit `(b, b, ½ − b, ½ − b)`.
+//! - degree 5: the classical 14-point rule with positive weights (as listed
+//!   e.g. by Walkington 2000, "Quadrature on simplices of arbitrary
+//!   dimension"): two orbits `(a, a, a, 1 − 3a)` and one orbit
+//!   `(b, b, ½ − b, ½ − b)`; its 16-digit constants are verified by the
+//!   exactness test, not trusted.
 //! - any odd degree `2s + 1`: Grundmann & Möller 1978 ("Invariant integration
 //!   formulas for the n-simplex by combinatorial methods", SIAM J. Numer.
 //!   Anal. 15), built from its closed formula; it has negative weights and is
