@@ -44,8 +44,20 @@ fn bank(n: usize) -> ModeBank {
         residuals: vec![0.0; n],
         shapes,
         surface,
-        material: Material { name: None, youngs_pa: 2e11, poisson: 0.3, density_kg_m3: 7850.0, alpha: 0.0, beta: 0.0 },
-        mass: MassProperties { volume_m3: 1.0, mass_kg: 1.0, center_of_mass_m: [0.0; 3], inertia_kg_m2: [[0.0; 3]; 3] },
+        material: Material {
+            name: None,
+            youngs_pa: 2e11,
+            poisson: 0.3,
+            density_kg_m3: 7850.0,
+            alpha: 0.0,
+            beta: 0.0,
+        },
+        mass: MassProperties {
+            volume_m3: 1.0,
+            mass_kg: 1.0,
+            center_of_mass_m: [0.0; 3],
+            inertia_kg_m2: [[0.0; 3]; 3],
+        },
         info: SolveInfo::default(),
     }
 }
