@@ -102,11 +102,12 @@ impl BankProvider for InMemoryProvider {
     }
 }
 
-/// Asks the provider once per distinct request; returns one bank per object.
+/// Asks the provider once per distinct request; returns one bank per object
+/// and the number of provider calls.
 pub(crate) fn resolve_banks(
     scene: &Scene,
     provider: &mut dyn BankProvider,
-) -> Result<Vec<Arc<ModeBank>>, SceneError> {
+) -> Result<(Vec<Arc<ModeBank>>, usize), SceneError> {
     let mut distinct: Vec<(BankRequest, Arc<ModeBank>)> = Vec::new();
     let mut banks = Vec::with_capacity(scene.objects.len());
     for (i, object) in scene.objects.iter().enumerate() {
@@ -123,7 +124,7 @@ pub(crate) fn resolve_banks(
         distinct.push((request, Arc::clone(&bank)));
         banks.push(bank);
     }
-    Ok(banks)
+    Ok((banks, distinct.len()))
 }
 
 /// The scene relies on a bank's surface and mass properties; reject banks it

@@ -148,8 +148,8 @@ pub fn render(
         ..Default::default()
     };
     let t = Instant::now();
-    let banks = resolve_banks(scene, provider)?;
-    report.banks_requested = count_distinct(&banks);
+    let (banks, requested) = resolve_banks(scene, provider)?;
+    report.banks_requested = requested;
     report.banks_s = t.elapsed().as_secs_f64();
     check_ground_clearance(scene, &banks)?;
 
@@ -179,13 +179,6 @@ pub fn render(
     report.peak = channels.iter().flatten().fold(0.0f64, |m, x| m.max((*x as f64).abs()));
     report.clipped_samples = channels.iter().flatten().filter(|x| x.abs() > 1.0).count();
     Ok(Rendered { channels, sample_rate: scene.sample_rate_hz, report, events: sim.events })
-}
-
-fn count_distinct(banks: &[Arc<ModeBank>]) -> usize {
-    let mut seen: Vec<*const ModeBank> = banks.iter().map(Arc::as_ptr).collect();
-    seen.sort();
-    seen.dedup();
-    seen.len()
 }
 
 struct Simulation {

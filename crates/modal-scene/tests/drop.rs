@@ -61,3 +61,38 @@ fn drop_onset_is_free_fall_time_plus_propagation() {
     eprintln!("onset {t_onset} expected {expected} events {:?}", &out.events[..out.events.len().min(3)]);
     assert!((t_onset - expected).abs() < 1e-3, "onset {t_onset} s, expected {expected} s");
 }
+
+fn db(x: f32, reference: f32) -> f64 {
+    20.0 * (x as f64 / reference as f64).log10()
+}
+
+#[test]
+fn resting_ball_is_silent_after_the_impact() {
+    // Steel elastic constants with strong damping (d = 30/s): the impact's
+    // own ring falls by > 100 dB within 0.5 s, so whatever is heard later
+    // would be re-triggered by the resting contact.
+    let damped = modal_fem::Material::custom(2.0e11, 0.29, 7850.0, 60.0, 0.0).expect("material");
+    let mut p = InMemoryProvider::new();
+    p.insert("sphere", common::ball_of(R, &[1500.0, 3100.0, 4700.0], damped));
+    let scene = drop_scene(0.05, 0.0, 2.5, [0.0, 0.3, 0.6]);
+    let out = render(&scene, &mut p, &RenderOptions { collect_events: true }).expect("render");
+    let y = &out.channels[0];
+    let fs = scene.sample_rate_hz as f64;
+    let peak = common::peak(y);
+    let late = common::peak(&y[(1.5 * fs) as usize..]);
+    let last_event = out.events.last().map_or(0.0, |e| e.time_s);
+    eprintln!("impacts {} last at {last_event} s, late level {:.1} dB", out.events.len(), db(late, peak));
+    assert!(last_event < 0.5, "contact re-triggered at {last_event} s: {:?}", out.events.last());
+    assert!(db(late, peak) < -80.0, "late level {:.1} dB re peak", db(late, peak));
+}
+
+#[test]
+fn harder_throw_is_louder() {
+    let gentle = drop_scene(0.05, 0.0, 0.3, [0.0, 0.3, 0.6]);
+    let hard = drop_scene(0.05, -3.0, 0.3, [0.0, 0.3, 0.6]);
+    let a = render(&gentle, &mut provider(), &RenderOptions::default()).expect("render");
+    let b = render(&hard, &mut provider(), &RenderOptions::default()).expect("render");
+    let (pa, pb) = (common::peak(&a.channels[0]), common::peak(&b.channels[0]));
+    eprintln!("gentle {pa} hard {pb}");
+    assert!(pb > 2.0 * pa, "gentle peak {pa}, hard peak {pb}");
+}

@@ -41,8 +41,13 @@ pub fn bank_on(mesh: &TetMesh, material: Material, freqs_hz: &[f64]) -> ModeBank
 
 /// A steel ball of radius `r` with modes at `freqs_hz`.
 pub fn ball(r: f64, freqs_hz: &[f64]) -> ModeBank {
+    ball_of(r, freqs_hz, Material::preset("steel").expect("steel"))
+}
+
+/// A ball of radius `r` and `material` with modes at `freqs_hz`.
+pub fn ball_of(r: f64, freqs_hz: &[f64], material: Material) -> ModeBank {
     let mesh = modal_mesh::generate::sphere(r, r / 2.0, 1).expect("sphere mesh");
-    bank_on(&mesh, Material::preset("steel").expect("steel"), freqs_hz)
+    bank_on(&mesh, material, freqs_hz)
 }
 
 /// A wooden box of `size` with modes at `freqs_hz`.
