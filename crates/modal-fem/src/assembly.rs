@@ -27,7 +27,7 @@ use crate::{FemError, Material};
 /// Elements whose matrices are computed in one parallel batch.
 const CHUNK: usize = 1024;
 
-/// Assembled global stiffness `k` [N/m] and consistent mass `m` [kg], both
+/// Assembled global stiffness `k` \[N/m\] and consistent mass `m` \[kg\], both
 /// `3·nodes × 3·nodes`, full symmetric storage, same sparsity pattern.
 #[derive(Clone, Debug)]
 pub struct Assembly {

@@ -12,7 +12,7 @@ use crate::FemError;
 
 /// Per-DOF clamp mask (`3·nodes` long, DOF `3i + c`): true for the three
 /// DOFs of every node inside the closed axis-aligned box
-/// `[x0, y0, z0, x1, y1, z1]` [m].
+/// `[x0, y0, z0, x1, y1, z1]` \[m\].
 pub fn fix_box(nodes: &[[f64; 3]], bounds: [f64; 6]) -> Vec<bool> {
     let [x0, y0, z0, x1, y1, z1] = bounds;
     let (lo, hi) = ([x0, y0, z0], [x1, y1, z1]);

@@ -59,7 +59,7 @@ pub fn shape_functions(nodes: usize, p: [f64; 3], n: &mut [f64], dn: &mut [[f64;
 pub struct PointData {
     /// Shape function values.
     pub n: [f64; MAX_NODES],
-    /// Physical gradients ∇Nₐ [1/m].
+    /// Physical gradients ∇Nₐ \[1/m\].
     pub grad: [[f64; 3]; MAX_NODES],
     /// Jacobian determinant `det(∂x/∂ξ)` (6 × volume for a straight tet).
     pub det: f64,

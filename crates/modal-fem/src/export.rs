@@ -46,7 +46,7 @@ pub fn write_matrix_market(a: &SparseColMat<usize, f64>, out: impl Write) -> io:
     out.flush()
 }
 
-/// Writes node coordinates [m] as CSV with header `x,y,z`, full precision.
+/// Writes node coordinates \[m\] as CSV with header `x,y,z`, full precision.
 pub fn write_nodes_csv(nodes: &[[f64; 3]], out: impl Write) -> io::Result<()> {
     let mut out = io::BufWriter::new(out);
     writeln!(out, "x,y,z")?;

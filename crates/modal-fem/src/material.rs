@@ -1,7 +1,7 @@
 //! Isotropic linear-elastic materials with Rayleigh damping `C = αM + βK`.
 //!
-//! For a mode of undamped angular frequency ω [rad/s]: decay rate
-//! `d = (α + β ω²)/2` [1/s], damping ratio `ξ = (α/ω + β ω)/2`
+//! For a mode of undamped angular frequency ω \[rad/s\]: decay rate
+//! `d = (α + β ω²)/2` \[1/s\], damping ratio `ξ = (α/ω + β ω)/2`
 //! (`shared/reference/materials.md`). α multiplies the mass matrix, β the
 //! stiffness matrix — some codes swap the two names; we do not.
 //!
@@ -20,15 +20,15 @@ use serde::{Deserialize, Serialize};
 pub struct Material {
     /// Preset name, if the material came from one.
     pub name: Option<String>,
-    /// Young's modulus E [Pa].
+    /// Young's modulus E \[Pa\].
     pub youngs_pa: f64,
-    /// Poisson's ratio ν [-], −1 < ν < 0.5.
+    /// Poisson's ratio ν \[-\], −1 < ν < 0.5.
     pub poisson: f64,
-    /// Density ρ [kg/m³].
+    /// Density ρ \[kg/m³\].
     pub density_kg_m3: f64,
-    /// Rayleigh mass-proportional damping α [1/s].
+    /// Rayleigh mass-proportional damping α \[1/s\].
     pub alpha: f64,
-    /// Rayleigh stiffness-proportional damping β [s].
+    /// Rayleigh stiffness-proportional damping β \[s\].
     pub beta: f64,
 }
 
@@ -47,7 +47,7 @@ pub enum MaterialError {
     Missing(&'static str),
 }
 
-/// One preset: name, ρ [kg/m³], E [Pa], ν, α [1/s], β [s].
+/// One preset: name, ρ \[kg/m³\], E \[Pa\], ν, α \[1/s\], β \[s\].
 struct Preset {
     name: &'static str,
     density: f64,
@@ -89,15 +89,15 @@ const ALIASES: [(&str, &str); 2] = [("aluminum", "aluminium"), ("abs", "plastic"
 /// `None` keeps the preset's value.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MaterialOverrides {
-    /// Young's modulus E [Pa].
+    /// Young's modulus E \[Pa\].
     pub youngs: Option<f64>,
     /// Poisson's ratio ν.
     pub poisson: Option<f64>,
-    /// Density ρ [kg/m³].
+    /// Density ρ \[kg/m³\].
     pub density: Option<f64>,
-    /// Rayleigh α [1/s].
+    /// Rayleigh α \[1/s\].
     pub alpha: Option<f64>,
-    /// Rayleigh β [s].
+    /// Rayleigh β \[s\].
     pub beta: Option<f64>,
 }
 
@@ -111,12 +111,12 @@ pub struct ResolvedMaterial {
     pub damping_defaulted_to_zero: bool,
 }
 
-/// Lamé parameters λ and μ (= shear modulus G) [Pa].
+/// Lamé parameters λ and μ (= shear modulus G) \[Pa\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lame {
-    /// First Lamé parameter λ [Pa].
+    /// First Lamé parameter λ \[Pa\].
     pub lambda: f64,
-    /// Shear modulus μ = G [Pa].
+    /// Shear modulus μ = G \[Pa\].
     pub mu: f64,
 }
 
@@ -145,7 +145,7 @@ impl Material {
         })
     }
 
-    /// A custom, validated material from E [Pa], ν, ρ [kg/m³], α [1/s], β [s].
+    /// A custom, validated material from E \[Pa\], ν, ρ \[kg/m³\], α \[1/s\], β \[s\].
     pub fn custom(
         youngs_pa: f64,
         poisson: f64,
@@ -234,17 +234,17 @@ impl Material {
         Ok(())
     }
 
-    /// Modal decay rate `d = (α + β ω²)/2` [1/s] at angular frequency ω [rad/s].
+    /// Modal decay rate `d = (α + β ω²)/2` \[1/s\] at angular frequency ω \[rad/s\].
     pub fn decay_rate(&self, omega_rad_s: f64) -> f64 {
         0.5 * (self.alpha + self.beta * omega_rad_s * omega_rad_s)
     }
 
-    /// Modal damping ratio `ξ = (α/ω + β ω)/2` at angular frequency ω [rad/s] (> 0).
+    /// Modal damping ratio `ξ = (α/ω + β ω)/2` at angular frequency ω \[rad/s\] (> 0).
     pub fn damping_ratio(&self, omega_rad_s: f64) -> f64 {
         0.5 * (self.alpha / omega_rad_s + self.beta * omega_rad_s)
     }
 
-    /// Lamé parameters λ, μ [Pa].
+    /// Lamé parameters λ, μ \[Pa\].
     pub fn lame(&self) -> Lame {
         let (e, nu) = (self.youngs_pa, self.poisson);
         Lame { lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu: e / (2.0 * (1.0 + nu)) }
