@@ -8,14 +8,50 @@
 
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
-/// Y = A X for a sparse A stored in full symmetric form.
+/// Y = A X for a sparse A (any storage; used with full symmetric K and M).
+///
+/// X is copied to row-major blocks of `p` values per row so that A is streamed once for all
+/// columns (faer's generic sparse×dense product streams A once per column).
 pub fn spmm(a: SparseColMatRef<'_, usize, f64>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let mut y = Mat::zeros(a.nrows(), x.ncols());
-    sparse_dense_matmul(y.as_mut(), Accum::Replace, a, x, 1.0, Par::Seq);
+    let (n, p) = (a.nrows(), x.ncols());
+    let mut y = Mat::zeros(n, p);
+    if p == 0 {
+        return y;
+    }
+    let nc = a.ncols();
+    let mut xr = vec![0.0; nc * p];
+    for j in 0..p {
+        for (i, v) in x.col(j).iter().enumerate() {
+            xr[i * p + j] = *v;
+        }
+    }
+    let mut yr = vec![0.0; n * p];
+    let (sym, vals) = (a.symbolic(), a.val());
+    let col_ptr = sym.col_ptr();
+    let row_idx = sym.row_idx();
+    let col_nnz = sym.col_nnz();
+    for c in 0..nc {
+        let start = col_ptr[c];
+        let end = match col_nnz {
+            Some(nnz) => start + nnz[c],
+            None => col_ptr[c + 1],
+        };
+        let xc = &xr[c * p..(c + 1) * p];
+        for (&r, &v) in row_idx[start..end].iter().zip(&vals[start..end]) {
+            let yrow = &mut yr[r * p..(r + 1) * p];
+            for (yv, xv) in yrow.iter_mut().zip(xc) {
+                *yv += v * xv;
+            }
+        }
+    }
+    for j in 0..p {
+        for (i, v) in y.as_mut().col_mut(j).iter_mut().enumerate() {
+            *v = yr[i * p + j];
+        }
+    }
     y
 }
 
@@ -98,17 +134,22 @@ pub fn hcat(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     c
 }
 
-/// M-orthonormalizes the columns of `z` in place (SVQB, twice), keeping at most `max_rank`
-/// directions whose M-norm exceeds `drop` × (largest M-norm). Returns (rank, B) with
+/// M-orthonormalizes the columns of `z` in place (SVQB, twice), keeping directions whose
+/// M-norm exceeds `drop` × (largest M-norm). Returns (rank, B) with
 /// `z_in ≈ z_out[:, ..rank] · B` (B is rank × ncols); columns beyond rank are garbage.
-pub fn svqb(m: SparseColMatRef<'_, usize, f64>, mut z: MatMut<'_, f64>, drop: f64) -> (usize, Mat<f64>) {
+pub fn svqb(m: SparseColMatRef<'_, usize, f64>, z: MatMut<'_, f64>, drop: f64) -> (usize, Mat<f64>) {
+    let mut mz = spmm(m, z.rb());
+    svqb_with(z, mz.as_mut(), drop)
+}
+
+/// [`svqb`] given `mz = M z`; both are updated (no sparse product).
+pub fn svqb_with(mut z: MatMut<'_, f64>, mut mz: MatMut<'_, f64>, drop: f64) -> (usize, Mat<f64>) {
     let p = z.ncols();
     let mut b_total = Mat::<f64>::identity(p, p);
     let mut rank = p;
     for pass in 0..2 {
         let zr = z.rb().subcols(0, rank);
-        let mz = spmm(m, zr);
-        let g = tmul(zr, mz.as_ref());
+        let g = tmul(zr, mz.rb().subcols(0, rank));
         let Some((s, u)) = sym_eig(g.as_ref()) else {
             return (0, Mat::zeros(0, p));
         };
@@ -129,6 +170,8 @@ pub fn svqb(m: SparseColMatRef<'_, usize, f64>, mut z: MatMut<'_, f64>, drop: f6
         let mut q = Mat::<f64>::zeros(z.nrows(), r);
         matmul(q.as_mut(), Accum::Replace, zr, t.as_ref(), 1.0, Par::Seq);
         z.rb_mut().subcols_mut(0, r).copy_from(q.as_ref());
+        matmul(q.as_mut(), Accum::Replace, mz.rb().subcols(0, rank), t.as_ref(), 1.0, Par::Seq);
+        mz.rb_mut().subcols_mut(0, r).copy_from(q.as_ref());
         let mut nb = Mat::<f64>::zeros(r, p);
         matmul(nb.as_mut(), Accum::Replace, bt.as_ref(), b_total.as_ref().subrows(0, rank), 1.0, Par::Seq);
         b_total = nb;
@@ -152,20 +195,20 @@ pub fn symmetrize(mut a: MatMut<'_, f64>) {
     }
 }
 
-/// Block CGS2 of `z` against the deflation set and `basis` (both M-orthonormal).
-/// Returns the accumulated coefficients C (basis.ncols() × z.ncols()), z ← z − basis C.
+/// Block CGS2 of `z` against the deflation set and `basis` (both M-orthonormal, with their
+/// M-images `mbasis`). Returns the accumulated coefficients C, z ← z − basis C. No sparse
+/// product: ⟨basis, z⟩_M = (M basis)ᵀ z.
 pub fn orthogonalize(
-    m: SparseColMatRef<'_, usize, f64>,
     defl: &Deflation,
     basis: MatRef<'_, f64>,
+    mbasis: MatRef<'_, f64>,
     mut z: MatMut<'_, f64>,
 ) -> Mat<f64> {
     let mut coeffs = Mat::<f64>::zeros(basis.ncols(), z.ncols());
     for _ in 0..2 {
         defl.project_out(z.rb_mut());
         if basis.ncols() > 0 {
-            let mz = spmm(m, z.rb());
-            let c = tmul(basis, mz.as_ref());
+            let c = tmul(mbasis, z.rb());
             matmul(z.rb_mut(), Accum::Add, basis, c.as_ref(), -1.0, Par::Seq);
             coeffs += &c;
         }
@@ -174,68 +217,68 @@ pub fn orthogonalize(
 }
 
 /// M-orthonormal block orthogonal to `defl` and `basis`: orthogonalizes `z`, SVQB, and
-/// replaces rank-deficient directions by random ones. Returns B (z.ncols() × z.ncols()) with
-/// z_in − basis·C = z_out · B, and C.
+/// replaces rank-deficient directions by random ones. Returns (B, C, M z_out) with
+/// z_in − basis·C = z_out · B.
 pub fn next_block(
     m: SparseColMatRef<'_, usize, f64>,
     defl: &Deflation,
     basis: MatRef<'_, f64>,
+    mbasis: MatRef<'_, f64>,
     mut z: MatMut<'_, f64>,
     rng: &mut Rng,
-) -> (Mat<f64>, Mat<f64>) {
+) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
     let p = z.ncols();
-    let norm_before = m_norm_max(m, z.rb());
-    let c = orthogonalize(m, defl, basis, z.rb_mut());
-    let norm_after = m_norm_max(m, z.rb());
-    let drop = if norm_after > 0.0 { 1e-10 * norm_before.max(norm_after) / norm_after } else { 1.0 };
-    let (rank, b_small) = svqb(m, z.rb_mut(), drop.min(1.0));
+    let norm_before = col_norm_max(z.rb());
+    let c = orthogonalize(defl, basis, mbasis, z.rb_mut());
+    let norm_after = col_norm_max(z.rb());
+    // Euclidean norms only gauge the cancellation; SVQB's drop is on M-norms relative to
+    // the largest remaining column.
+    let drop = if norm_after > 0.0 { (1e-10 * norm_before / norm_after).min(1.0) } else { 1.0 };
+    let mut mz = spmm(m, z.rb());
+    let (rank, b_small) = svqb_with(z.rb_mut(), mz.as_mut(), drop);
     let mut b = Mat::<f64>::zeros(p, p);
     b.as_mut().subrows_mut(0, rank).copy_from(b_small.as_ref());
     if rank < p {
         // Breakdown: the Krylov space is (nearly) invariant; continue with random directions.
         let mut fill = Mat::<f64>::zeros(z.nrows(), p - rank);
+        let both = hcat(basis, z.rb().subcols(0, rank));
+        let mboth = hcat(mbasis, mz.as_ref().subcols(0, rank));
+        let mut mfill = Mat::<f64>::zeros(z.nrows(), p - rank);
         for _attempt in 0..3 {
             rng.fill(fill.as_mut());
-            let both = hcat(basis, z.rb().subcols(0, rank));
-            orthogonalize(m, defl, both.as_ref(), fill.as_mut());
-            let (r2, _) = svqb(m, fill.as_mut(), 1e-8);
+            orthogonalize(defl, both.as_ref(), mboth.as_ref(), fill.as_mut());
+            mfill = spmm(m, fill.as_ref());
+            let (r2, _) = svqb_with(fill.as_mut(), mfill.as_mut(), 1e-8);
             if r2 == p - rank {
                 break;
             }
         }
         z.rb_mut().subcols_mut(rank, p - rank).copy_from(fill.as_ref());
+        mz.as_mut().subcols_mut(rank, p - rank).copy_from(mfill.as_ref());
     }
-    (b, c)
+    (b, c, mz)
 }
 
-/// max_j ‖z_j‖_M.
-fn m_norm_max(m: SparseColMatRef<'_, usize, f64>, z: MatRef<'_, f64>) -> f64 {
-    let mz = spmm(m, z);
-    (0..z.ncols())
-        .map(|j| {
-            let mut s = 0.0;
-            for i in 0..z.nrows() {
-                s += z[(i, j)] * mz[(i, j)];
-            }
-            s.max(0.0).sqrt()
-        })
-        .fold(0.0, f64::max)
+/// max_j ‖z_j‖₂.
+fn col_norm_max(z: MatRef<'_, f64>) -> f64 {
+    (0..z.ncols()).map(|j| z.col(j).norm_l2()).fold(0.0, f64::max)
 }
 
 /// Rayleigh–Ritz of the pencil (K, M) on span(y): M-orthonormalizes y (SVQB), solves the
-/// projected problem, returns (λ ascending, M-orthonormal Ritz vectors).
+/// projected problem, returns (λ ascending, M-orthonormal Ritz vectors, relative residuals).
 #[allow(non_snake_case)]
 pub fn rayleigh_ritz_kM(
     k: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,
     mut y: Mat<f64>,
-) -> Result<(Vec<f64>, Mat<f64>), crate::EigenError> {
+) -> Result<RitzSet, crate::EigenError> {
     let n = k.nrows();
     let q = y.ncols();
     if q == 0 {
-        return Ok((Vec::new(), y));
+        return Ok((Vec::new(), y, Vec::new()));
     }
-    let (rank, _) = svqb(m, y.as_mut(), 1e-12);
+    let mut my = spmm(m, y.as_ref());
+    let (rank, _) = svqb_with(y.as_mut(), my.as_mut(), 1e-12);
     if rank < q {
         return Err(crate::EigenError::Factorization("converged vectors are linearly dependent".into()));
     }
@@ -245,7 +288,12 @@ pub fn rayleigh_ritz_kM(
         .ok_or_else(|| crate::EigenError::Factorization("dense eigensolver failed".into()))?;
     let mut w = Mat::<f64>::zeros(n, q);
     matmul(w.as_mut(), Accum::Replace, y.as_ref(), u.as_ref(), 1.0, Par::Seq);
-    Ok((lams, w))
+    let mut kw = Mat::<f64>::zeros(n, q);
+    matmul(kw.as_mut(), Accum::Replace, ky.as_ref(), u.as_ref(), 1.0, Par::Seq);
+    let mut mw = Mat::<f64>::zeros(n, q);
+    matmul(mw.as_mut(), Accum::Replace, my.as_ref(), u.as_ref(), 1.0, Par::Seq);
+    let res = residuals_from(&lams, kw.as_ref(), mw.as_ref());
+    Ok((lams, w, res))
 }
 
 /// Eigen-decomposition of a small symmetric matrix (ascending), computed on a copy scaled to
@@ -264,4 +312,22 @@ pub fn sym_eig(a: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     let eig = t.self_adjoint_eigen(Side::Lower).ok()?;
     let vals = (0..n).map(|i| eig.S().column_vector()[i] * scale).collect();
     Some((vals, eig.U().to_owned()))
+}
+
+/// (λ ascending, M-orthonormal vectors, relative residuals).
+pub type RitzSet = (Vec<f64>, Mat<f64>, Vec<f64>);
+
+/// Relative residuals ‖K w − λ M w‖₂ / (|λ| ‖M w‖₂) from the products K w and M w.
+pub fn residuals_from(lambdas: &[f64], kw: MatRef<'_, f64>, mw: MatRef<'_, f64>) -> Vec<f64> {
+    (0..kw.ncols())
+        .map(|j| {
+            let (mut r2, mut m2) = (0.0, 0.0);
+            for i in 0..kw.nrows() {
+                let r = kw[(i, j)] - lambdas[j] * mw[(i, j)];
+                r2 += r * r;
+                m2 += mw[(i, j)] * mw[(i, j)];
+            }
+            r2.sqrt() / (lambdas[j].abs() * m2.sqrt()).max(f64::MIN_POSITIVE)
+        })
+        .collect()
 }

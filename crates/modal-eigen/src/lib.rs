@@ -18,5 +18,6 @@ mod ordering;
 mod solve;
 mod types;
 
+pub use krylov::attainable as residual_bound;
 pub use solve::solve;
 pub use types::*;

@@ -3,14 +3,14 @@
 //!
 //! Shift choice ("scaled to the problem"): with `λ_lo = (2π f_min)²`, the LDLᵀ of `K − λ_lo M`
 //! counts the eigenvalues below the band (ν_lo, rigid ones included). If few elastic modes lie
-//! below the band, the operator shift is `σ = −max(λ_lo, 1e-8·λ_scale)` where
+//! below the band, the operator shift is `σ = −max(λ_lo, 1e-10·λ_scale)` where
 //! `λ_scale = maxᵢ Kᵢᵢ/Mᵢᵢ` estimates the top of the spectrum; this keeps `K − σM` positive
-//! definite with condition ≲ 1e8 whatever the units, so Cholesky is used. If many modes lie
+//! definite with condition ≲ 1e10 whatever the units, so Cholesky is used. If many modes lie
 //! below the band (ultrasonic bands), the LDLᵀ factor at `σ = λ_lo` itself is the operator.
 
-use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation};
+use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation, RitzSet};
 use crate::factor::ShiftedFactor;
-use crate::krylov::{residuals, search, Counters, KsConfig};
+use crate::krylov::{attainable, residuals, search, Counters, KsConfig};
 use crate::types::*;
 use faer::linalg::matmul::matmul;
 use faer::sparse::SparseColMatRef;
@@ -19,6 +19,8 @@ use std::time::Instant;
 
 /// Elastic modes below the band up to which the operator shift goes below the spectrum.
 const MAX_BELOW_FOR_LOW_SHIFT: usize = 24;
+/// Smallest |σ| relative to the spectrum scale max Kᵢᵢ/Mᵢᵢ (condition of K − σM ≲ 1e10).
+const SHIFT_FLOOR: f64 = 1e-10;
 /// Searches for missed modes after an inertia mismatch.
 const MAX_SEARCHES: usize = 4;
 
@@ -42,6 +44,7 @@ pub fn solve(
     let lam_lo = hz_to_lambda(opts.min_freq_hz);
     let lam_hi = hz_to_lambda(opts.max_freq_hz);
     let lam_scale = spectrum_scale(k, m)?;
+    stats.lambda_scale = lam_scale;
 
     // Rigid-body deflation.
     let mut defl = Deflation::empty(n);
@@ -88,7 +91,7 @@ pub fn solve(
     stats.elastic_below_band = elastic_below;
     let low_shift = lam_lo == 0.0 || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
     if low_shift {
-        let sigma = -lam_lo.max(1e-8 * lam_scale);
+        let sigma = -lam_lo.max(SHIFT_FLOOR * lam_scale);
         stats.factorizations += 1;
         factor.factor_llt(sigma)?;
     }
@@ -128,6 +131,7 @@ pub fn solve(
                 max_restarts: opts.max_restarts,
                 tol: opts.tolerance,
                 seed: 0x5EED_0000 + searches as u64,
+                lambda_scale: lam_scale,
             };
             search(&factor, k, m, &defl, &cfg, &enough, &mut counters, progress)?
         };
@@ -141,8 +145,7 @@ pub fn solve(
             .take(cap)
             .collect();
         let capped = sel.len() == cap;
-        let (lams, vecs) = polish(k, m, &known, &sel)?;
-        let res = residuals(k, m, &lams, vecs.as_ref());
+        let (lams, vecs, res) = polish(k, m, &known, &sel)?;
         let sigma_hi = upper_check_shift(&known.lambdas, &lams, capped, lam_hi);
         stats.factorizations += 1;
         let nu_hi = inertia(&mut factor, sigma_hi)?;
@@ -156,8 +159,12 @@ pub fn solve(
         let dt = t_check.elapsed().as_secs_f64();
         check_s += dt;
         progress(Progress::PhaseEnd { phase: Phase::Check, seconds: dt });
-        let worst = res.iter().cloned().fold(0.0, f64::max);
-        if nu_hi == found && worst <= opts.tolerance {
+        let worst = res
+            .iter()
+            .zip(&lams)
+            .map(|(r, l)| r / attainable(opts.tolerance, *l, lam_scale))
+            .fold(0.0, f64::max);
+        if nu_hi == found && worst <= 1.0 {
             stats.block_solves = counters.block_solves;
             stats.iterations = counters.restarts;
             stats.check_s = check_s;
@@ -245,9 +252,9 @@ fn polish(
     m: SparseColMatRef<'_, usize, f64>,
     known: &Known,
     sel: &[usize],
-) -> Result<(Vec<f64>, Mat<f64>), EigenError> {
+) -> Result<RitzSet, EigenError> {
     let n = k.nrows();
-    let Some(all) = &known.vectors else { return Ok((Vec::new(), Mat::zeros(n, 0))) };
+    let Some(all) = &known.vectors else { return Ok((Vec::new(), Mat::zeros(n, 0), Vec::new())) };
     let mut y = Mat::<f64>::zeros(n, sel.len());
     for (c, &i) in sel.iter().enumerate() {
         y.as_mut().col_mut(c).copy_from(all.col(i));

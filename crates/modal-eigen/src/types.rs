@@ -101,6 +101,9 @@ pub struct SolveStats {
     pub check_s: f64,
     /// Ordering used.
     pub ordering: Option<OrderingUsed>,
+    /// Spectrum scale maxᵢ Kᵢᵢ/Mᵢᵢ (rad²/s²); each mode's residual bound is
+    /// [`crate::residual_bound`]`(tolerance, λ, lambda_scale)`.
+    pub lambda_scale: f64,
 }
 
 /// Result of [`crate::solve`].
