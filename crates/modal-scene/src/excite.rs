@@ -8,7 +8,12 @@
 //! must not strike them. Only the *rise* `ΔJ_k = J_k − J_{k−1}` (with
 //! `J_{k−1} = 0` when the pair did not touch in the previous step) excites,
 //! and only when it exceeds [`SUSTAIN_DEADBAND`] × `J_{k−1}` (solver jitter of
-//! a resting contact) and [`MIN_IMPULSE_NS`]. The rise is shared among the
+//! a resting contact) and [`MIN_IMPULSE_NS`], and only when the contact
+//! closes at [`MIN_APPROACH_M_S`] or faster: the contact point of a resting,
+//! rolling or rocking body has no normal approach speed, whereas an impact
+//! (also a second corner landing while the first still touches) has. The
+//! faceted convex hull of a curved body (a bowl) rocks across facet edges at
+//! a few cm/s; the threshold treats that as the rolling it stands for. The rise is shared among the
 //! pair's points in proportion to their impulse: point `i` with impulse
 //! vector `p_i` (normal + friction) strikes with `(ΔJ_k / J_k) · p_i`. A new
 //! impact therefore sounds with its full impulse, a resting or rolling
@@ -36,6 +41,8 @@ use crate::physics::{ContactSide, PairContacts};
 /// A rise below this fraction of the previous step's impulse is jitter of a
 /// sustained contact, not an impact.
 pub const SUSTAIN_DEADBAND: f64 = 0.25;
+/// Contacts closing slower than this never strike [m/s].
+pub const MIN_APPROACH_M_S: f64 = 0.05;
 /// Rises below this impulse are ignored [N·s].
 pub const MIN_IMPULSE_NS: f64 = 1e-9;
 /// Shortest contact time [s].
@@ -135,9 +142,12 @@ impl Exciter {
             if rise <= MIN_IMPULSE_NS || rise <= SUSTAIN_DEADBAND * before || total <= 0.0 {
                 continue;
             }
+            let approach = pair.points.iter().map(|p| p.approach_m_s).fold(0.0, f64::max);
+            if approach < MIN_APPROACH_M_S {
+                continue;
+            }
             let share = rise / total;
             let fresh = before == 0.0;
-            let approach = pair.points.iter().map(|p| p.approach_m_s).fold(0.0, f64::max);
             let time = if fresh {
                 let gap = pair.points.iter().map(|p| p.separation_m).fold(f64::INFINITY, f64::min);
                 let lead = if approach > 0.0 && gap > 0.0 { (gap / approach).min(dt) } else { 0.0 };

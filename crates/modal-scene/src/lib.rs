@@ -13,6 +13,7 @@ mod error;
 mod excite;
 mod listener;
 mod material;
+mod output;
 mod physics;
 mod provider;
 mod render;
@@ -21,11 +22,15 @@ mod validate;
 
 pub use error::SceneError;
 pub use excite::{
-    hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_CONTACT_TIME_S, MIN_IMPULSE_NS,
-    SUSTAIN_DEADBAND,
+    hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_APPROACH_M_S, MIN_CONTACT_TIME_S,
+    MIN_IMPULSE_NS, SUSTAIN_DEADBAND,
 };
 pub use listener::{MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
 pub use material::{preset_names, resolve_material};
+pub use modal_synth::WavFormat;
+pub use output::{
+    write_events_json, write_spectrogram_png, write_wav, SPECTROGRAM_RANGE_DB, SPECTROGRAM_WINDOW,
+};
 pub use physics::ContactSide;
 pub use provider::{BankProvider, BankRequest, InMemoryProvider, ProviderError};
 pub use render::{

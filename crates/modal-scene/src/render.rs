@@ -11,12 +11,14 @@
 //!    [`SILENCE_DB`] of its own peak with no strike pending;
 //! 4. **mix**: per object and ear, 1/r gain and r/c delay ([`crate::listener`]).
 //!
-//! **Level.** An object radiates `p(t) = ρ₀ c · (a / r) · v(t)` [Pa] at
-//! distance `r`: `v` is the RMS normal surface velocity of its modes
-//! ([`modal_synth::OutputGain::RadiationProxy`]), `a = √(A/4π)` the radius of
-//! the sphere with the object's surface area `A`, `ρ₀ c` =
-//! [`AIR_IMPEDANCE_PA_S_M`] (a baffled-piston estimate, good to a factor of a
-//! few). A sample value of 1.0 (full scale) is [`FULL_SCALE_PA`] times
+//! **Level.** Mode `i` radiates like a pulsating sphere of radius
+//! `a = √(A/4π)` (the sphere with the object's surface area `A`) whose
+//! surface moves with the mode's RMS normal surface velocity `v_i`
+//! (`modal_synth::SynthModel::rms_normal_shapes`):
+//! `p_i(r) = ρ₀ c · (a / r) · (k_i a / √(1 + (k_i a)²)) · v_i`, `k_i = ω_i / c`,
+//! `ρ₀ c` = [`AIR_IMPEDANCE_PA_S_M`]. The factor `k a/√(1 + (ka)²)` is the
+//! sphere's radiation roll-off: small, slow modes radiate poorly. It is an
+//! estimate of the level (good to a factor of a few), not a radiation solve. A sample value of 1.0 (full scale) is [`FULL_SCALE_PA`] times
 //! `listener.gain`⁻¹. There is no normalization; samples beyond ±1 are
 //! counted as clipped. The last [`FADE_OUT_S`] of the file fade out with a
 //! raised cosine so a cut-off ring never ends in a click.
@@ -279,7 +281,7 @@ fn synthesize(
                     object: names[i].clone(),
                     message: e.to_string(),
                 })?;
-                let gains = model.rms_normal_shapes();
+                let gains = radiation_gains(&model, bank);
                 models.push((key, (Arc::new(model), Arc::new(gains))));
                 models.len() - 1
             }
@@ -305,6 +307,21 @@ fn synthesize(
                 .map_err(|e| SceneError::Synthesis { object: names[i].clone(), message: e.to_string() })?;
             let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
             Ok(render_voice(voice, &strikes[i], total, fs, scale, report))
+        })
+        .collect()
+}
+
+/// Per-mode output gains: RMS normal shape × the sphere's radiation roll-off.
+fn radiation_gains(model: &SynthModel, bank: &ModeBank) -> Vec<f64> {
+    let a = equivalent_radius(bank);
+    let c = crate::listener::SPEED_OF_SOUND_M_S;
+    model
+        .rms_normal_shapes()
+        .iter()
+        .zip(&bank.frequencies_hz)
+        .map(|(g, f)| {
+            let ka = 2.0 * std::f64::consts::PI * f / c * a;
+            g * ka / (1.0 + ka * ka).sqrt()
         })
         .collect()
 }
