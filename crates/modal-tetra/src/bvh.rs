@@ -77,7 +77,7 @@ impl Bvh {
         omega / (4.0 * std::f64::consts::PI)
     }
 
-    /// Distance from `q` to the nearest triangle [m] (∞ when empty).
+    /// Distance from `q` to the nearest triangle (m) (∞ when empty).
     pub fn distance(&self, q: V3) -> f64 {
         let mut best = f64::INFINITY;
         if self.nodes.is_empty() {

@@ -21,11 +21,11 @@ pub struct SurfaceReport {
     pub vertices: usize,
     /// Part names, in file order.
     pub parts: Vec<String>,
-    /// Bounding box minimum corner [m].
+    /// Bounding box minimum corner (m).
     pub bbox_min: [f64; 3],
-    /// Bounding box maximum corner [m].
+    /// Bounding box maximum corner (m).
     pub bbox_max: [f64; 3],
-    /// Bounding-box diagonal [m].
+    /// Bounding-box diagonal (m).
     pub diagonal_m: f64,
     /// Vertices merged into an earlier one at the same position.
     pub duplicate_vertices: usize,
@@ -41,7 +41,7 @@ pub struct SurfaceReport {
     pub flipped_faces: usize,
     /// Edge-connected components (after welding).
     pub components: usize,
-    /// Σ |signed volume| of the oriented components [m³] (exact for closed
+    /// Σ |signed volume| of the oriented components (m³) (exact for closed
     /// surfaces; overlapping parts are counted twice).
     pub enclosed_volume_m3: f64,
     /// Human-readable warnings, e.g. the unit hint pointing to `--scale`.

@@ -74,7 +74,7 @@ pub enum TetraError {
     /// The requested resolution would exceed `TetOptions::max_tets`.
     #[error("cell size {cell_m:.3e} m would make about {estimated} tets, above the limit of {limit} (raise --cell or the limit)")]
     TooManyTets {
-        /// Cell size that was asked for or derived [m].
+        /// Cell size that was asked for or derived (m).
         cell_m: f64,
         /// Estimated number of tets.
         estimated: u64,
@@ -84,7 +84,7 @@ pub enum TetraError {
     /// The surface encloses no volume at the chosen resolution.
     #[error("no tets: the surface encloses no volume thicker than the cell size {cell_m:.3e} m (is it an open sheet, or is --cell too coarse?)")]
     NoVolume {
-        /// Cell size used [m].
+        /// Cell size used (m).
         cell_m: f64,
     },
 }

@@ -18,7 +18,7 @@ use crate::geom::{cross, dihedral_angles_deg, dot, lerp, norm, orient6, sub, V3}
 pub const FEATURE_ANGLE_DEG: f64 = 35.0;
 /// Boundary nodes closer than this fraction of h to a feature are snapped.
 pub const SNAP_FRACTION: f64 = 0.5;
-/// Dihedral range every tet around a moved node must keep [degrees].
+/// Dihedral range every tet around a moved node must keep (degrees).
 pub const GUARD_DEG: (f64, f64) = (10.0, 165.0);
 
 /// Feature edges (as segments) and corners of an oriented triangle surface.

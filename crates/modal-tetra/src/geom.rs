@@ -51,7 +51,7 @@ pub fn area_vector(a: V3, b: V3, c: V3) -> V3 {
     scale(cross(sub(b, a), sub(c, a)), 0.5)
 }
 
-/// The six dihedral angles of a tet [degrees], one per edge.
+/// The six dihedral angles of a tet (degrees), one per edge.
 pub fn dihedral_angles_deg(p: [V3; 4]) -> [f64; 6] {
     // Face normals (outward up to a common sign) of faces opposite each vertex.
     const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
@@ -140,7 +140,7 @@ pub fn segment_triangle(p: V3, q: V3, a: V3, b: V3, c: V3) -> Option<f64> {
     (0.0..=1.0).contains(&t).then_some(t)
 }
 
-/// Solid angle [sr] of triangle (a, b, c) seen from q, signed positive when
+/// Solid angle (sr) of triangle (a, b, c) seen from q, signed positive when
 /// q is on the back (inner) side of a counter-clockwise triangle
 /// (Van Oosterom & Strackee 1983).
 #[inline]

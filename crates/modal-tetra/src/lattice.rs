@@ -17,9 +17,9 @@ pub type Coord = [i64; 3];
 /// A finite BCC lattice covering a box.
 #[derive(Clone, Debug)]
 pub struct Lattice {
-    /// Position of doubled coordinate (0, 0, 0) [m].
+    /// Position of doubled coordinate (0, 0, 0) (m).
     pub origin: V3,
-    /// Cube edge h [m].
+    /// Cube edge h (m).
     pub h: f64,
     /// Number of cubes per axis.
     pub n: [usize; 3],
@@ -99,7 +99,7 @@ impl Lattice {
         }
     }
 
-    /// Position [m] of doubled coordinate `c`.
+    /// Position (m) of doubled coordinate `c`.
     pub fn position(&self, c: Coord) -> V3 {
         std::array::from_fn(|a| self.origin[a] + 0.5 * self.h * c[a] as f64)
     }

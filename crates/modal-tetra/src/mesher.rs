@@ -29,7 +29,7 @@ pub const DEFAULT_CELLS_PER_THICKNESS: f64 = 1.5;
 /// with neither, `cell = diagonal / cells_per_diagonal`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TetOptions {
-    /// BCC cube edge h [m]; tets have edges of about 0.87 h to h.
+    /// BCC cube edge h (m); tets have edges of about 0.87 h to h.
     pub cell: Option<f64>,
     /// Aim for about this many tets (the cell size is derived from the
     /// enclosed volume: one cube of h³ holds 12 tets).
@@ -77,17 +77,17 @@ pub struct TetReport {
     pub tets: usize,
     /// Number of nodes.
     pub nodes: usize,
-    /// Cell size h used [m].
+    /// Cell size h used (m).
     pub cell_m: f64,
-    /// Smallest dihedral angle over all tets [degrees].
+    /// Smallest dihedral angle over all tets (degrees).
     pub min_dihedral_deg: f64,
-    /// Largest dihedral angle over all tets [degrees].
+    /// Largest dihedral angle over all tets (degrees).
     pub max_dihedral_deg: f64,
-    /// Tet mesh volume [m³].
+    /// Tet mesh volume (m³).
     pub volume_m3: f64,
-    /// Volume enclosed by the (repaired) input surface [m³].
+    /// Volume enclosed by the (repaired) input surface (m³).
     pub surface_volume_m3: f64,
-    /// Largest distance from a boundary node of the mesh to the input surface [m].
+    /// Largest distance from a boundary node of the mesh to the input surface (m).
     pub max_surface_deviation_m: f64,
     /// Zero-volume slivers dropped by the stencils (expected 0).
     pub dropped_degenerate: usize,
@@ -231,7 +231,7 @@ fn boundary_nodes(tets: &[[usize; 4]]) -> Vec<usize> {
     nodes
 }
 
-/// Largest distance from the given nodes to the input surface [m].
+/// Largest distance from the given nodes to the input surface (m).
 fn deviation(nodes: &[V3], boundary: &[usize], bvh: &Bvh) -> f64 {
     boundary.par_iter().map(|&v| bvh.distance(nodes[v])).reduce(|| 0.0, f64::max)
 }

@@ -11,7 +11,7 @@ fn single(vertices: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>, name: &str) -> Tr
     TriSurface { vertices, triangles, parts: vec![(name.to_string(), 0..n)] }
 }
 
-/// Icosphere of `radius` [m] centred at the origin: 20·4^`subdivisions`
+/// Icosphere of `radius` (m) centred at the origin: 20·4^`subdivisions`
 /// triangles (3: 1280, 5: 20 480, 7: 327 680).
 pub fn icosphere(radius: f64, subdivisions: u32) -> TriSurface {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
@@ -76,7 +76,7 @@ pub fn icosphere(radius: f64, subdivisions: u32) -> TriSurface {
     single(v, f, "sphere")
 }
 
-/// Axis-aligned box [0, lx] × [0, ly] × [0, lz] [m], 12 triangles.
+/// Axis-aligned box [0, lx] × [0, ly] × [0, lz] (m), 12 triangles.
 pub fn cuboid(lx: f64, ly: f64, lz: f64) -> TriSurface {
     let v = (0..8)
         .map(|i| [(i & 1) as f64 * lx, ((i >> 1) & 1) as f64 * ly, ((i >> 2) & 1) as f64 * lz])
@@ -98,7 +98,7 @@ pub fn cuboid(lx: f64, ly: f64, lz: f64) -> TriSurface {
     single(v, f, "box")
 }
 
-/// Torus around the z axis (major radius `major`, tube radius `minor`) [m].
+/// Torus around the z axis (major radius `major`, tube radius `minor`) (m).
 pub fn torus(major: f64, minor: f64, segments: usize, sides: usize) -> TriSurface {
     let (n, m) = (segments.max(3), sides.max(3));
     let mut v = Vec::with_capacity(n * m);
@@ -158,7 +158,7 @@ pub fn revolve(profile: &[(f64, f64)], segments: usize, name: &str) -> TriSurfac
     single(v, f, name)
 }
 
-/// A hemispherical bowl of outer radius `radius` and wall `thickness` [m]
+/// A hemispherical bowl of outer radius `radius` and wall `thickness` (m)
 /// with a flat foot, opening upwards.
 pub fn bowl(radius: f64, thickness: f64, segments: usize) -> TriSurface {
     let steps = 16;
@@ -181,7 +181,7 @@ pub fn bowl(radius: f64, thickness: f64, segments: usize) -> TriSurface {
 }
 
 /// A bell-like shell of revolution: height `height`, mouth radius
-/// `mouth` [m], wall thickness `thickness` [m].
+/// `mouth` (m), wall thickness `thickness` (m).
 pub fn bell(height: f64, mouth: f64, thickness: f64, segments: usize) -> TriSurface {
     let steps = 24;
     let shape = |s: f64| {

@@ -12,7 +12,7 @@ use crate::TetraError;
 /// [`crate::diagnose`]; the inside test copes with them.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct TriSurface {
-    /// Vertex positions [m].
+    /// Vertex positions (m).
     pub vertices: Vec<[f64; 3]>,
     /// Triangles as vertex indices, counter-clockwise seen from outside when
     /// the file is well oriented.
@@ -22,7 +22,7 @@ pub struct TriSurface {
 }
 
 impl TriSurface {
-    /// Axis-aligned bounding box `(min, max)` of the referenced vertices [m].
+    /// Axis-aligned bounding box `(min, max)` of the referenced vertices (m).
     /// `None` when there are no triangles.
     pub fn bounding_box(&self) -> Option<([f64; 3], [f64; 3])> {
         let mut it = self.triangles.iter().flatten().map(|&v| self.vertices[v]);
@@ -32,7 +32,7 @@ impl TriSurface {
         }))
     }
 
-    /// Length of the bounding-box diagonal [m] (0 when empty).
+    /// Length of the bounding-box diagonal (m) (0 when empty).
     pub fn diagonal(&self) -> f64 {
         self.bounding_box().map(|(lo, hi)| crate::geom::norm(crate::geom::sub(hi, lo))).unwrap_or(0.0)
     }
