@@ -18,6 +18,7 @@ mod physics;
 mod provider;
 mod render;
 mod spec;
+pub mod stand_in;
 mod validate;
 
 pub use error::SceneError;

@@ -3,40 +3,13 @@
 
 #![allow(dead_code)]
 
-use modal_bank::{ModeBank, SolveInfo};
-use modal_fem::{mass_properties, Material};
-use modal_mesh::{boundary_surface, TetMesh};
+use modal_bank::ModeBank;
+use modal_fem::Material;
+use modal_mesh::TetMesh;
 
-/// A bank on `mesh` with modes at `freqs_hz` for `material`. Mode `i` has the
-/// smooth, nowhere-trivial shape `φ_i(x) = (cos(k_i x + i), sin(k_i y + 1),
-/// cos(k_i z + 2)) / √m` with `k_i` a few waves across the body, roughly the
-/// size of a mass-normalized elastic mode.
+/// A stand-in bank on `mesh` (see `modal_scene::stand_in`).
 pub fn bank_on(mesh: &TetMesh, material: Material, freqs_hz: &[f64]) -> ModeBank {
-    let surface = boundary_surface(mesh);
-    let mass = mass_properties(mesh, material.density_kg_m3);
-    let n = surface.positions.len();
-    let norm = 1.0 / mass.mass_kg.sqrt();
-    let mut shapes = Vec::with_capacity(freqs_hz.len() * n * 3);
-    for (i, _) in freqs_hz.iter().enumerate() {
-        let k = 40.0 + 17.0 * i as f64;
-        for p in &surface.positions {
-            shapes.push((norm * (k * p[0] + i as f64).cos()) as f32);
-            shapes.push((norm * (k * p[1] + 1.0).sin()) as f32);
-            shapes.push((norm * (k * p[2] + 2.0).cos()) as f32);
-        }
-    }
-    let omega: Vec<f64> = freqs_hz.iter().map(|f| 2.0 * std::f64::consts::PI * f).collect();
-    ModeBank {
-        frequencies_hz: freqs_hz.to_vec(),
-        damping_ratios: omega.iter().map(|w| material.damping_ratio(*w)).collect(),
-        decay_rates: omega.iter().map(|w| material.decay_rate(*w)).collect(),
-        residuals: vec![0.0; freqs_hz.len()],
-        shapes,
-        surface,
-        material,
-        mass,
-        info: SolveInfo { order: 1, ..Default::default() },
-    }
+    modal_scene::stand_in::synthetic_bank(mesh, material, freqs_hz)
 }
 
 /// A steel ball of radius `r` with modes at `freqs_hz`.
