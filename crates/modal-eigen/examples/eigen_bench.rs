@@ -46,6 +46,12 @@ fn main() {
     if let Ok(o) = std::env::var("ORDER") {
         opts.ordering = if o == "amd" { modal_eigen::Ordering::Amd } else { modal_eigen::Ordering::Metis };
     }
+    if let Ok(f) = std::env::var("MINF") {
+        opts.min_freq_hz = f.parse().expect("MINF");
+    }
+    if let Ok(f) = std::env::var("MAXF") {
+        opts.max_freq_hz = f.parse().expect("MAXF");
+    }
     if let Ok(b) = std::env::var("BLOCK") {
         opts.block_size = b.parse().expect("BLOCK");
     }
