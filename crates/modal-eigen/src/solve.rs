@@ -1,9 +1,10 @@
 //! The driver: validation, ordering, shift choice, searches, final Rayleigh–Ritz,
 //! residuals and the Sylvester inertia proof of completeness.
 //!
-//! Shift choice ("scaled to the problem"): with `λ_lo = (2π f_min)²`, the LDLᵀ of `K − λ_lo M`
-//! counts the eigenvalues below the band (ν_lo, rigid ones included). If few elastic modes lie
-//! below the band, the operator shift is `σ = −max(λ_lo, 1e-10·λ_scale)` where
+//! Shift choice ("scaled to the problem"): with `λ_lo = (2π f_min)²` and
+//! `λ_scale = maxᵢ Kᵢᵢ/Mᵢᵢ`: if `λ_lo ≤ 1e-6·λ_scale` (audio band edges) the search starts
+//! below the spectrum directly. Otherwise the LDLᵀ of `K − λ_lo M` first counts the eigenvalues
+//! below the band (ν_lo, rigid ones included). If few elastic modes lie below the band, the operator shift is `σ = −max(λ_lo, 1e-10·λ_scale)` where
 //! `λ_scale = maxᵢ Kᵢᵢ/Mᵢᵢ` estimates the top of the spectrum; this keeps `K − σM` positive
 //! definite with condition ≲ 1e10 whatever the units, so Cholesky is used. If many modes lie
 //! below the band (ultrasonic bands), the LDLᵀ factor at `σ = λ_lo` itself is the operator.
@@ -19,6 +20,8 @@ use std::time::Instant;
 
 /// Elastic modes below the band up to which the operator shift goes below the spectrum.
 const MAX_BELOW_FOR_LOW_SHIFT: usize = 24;
+/// Below `f_min` with λ_lo ≤ this × λ_scale, the lower inertia factorization is skipped.
+const LOW_EDGE_FRACTION: f64 = 1e-6;
 /// Smallest |σ| relative to the spectrum scale max Kᵢᵢ/Mᵢᵢ (condition of K − σM ≲ 1e10).
 const SHIFT_FLOOR: f64 = 1e-10;
 /// Searches for missed modes after an inertia mismatch.
@@ -81,15 +84,18 @@ pub fn solve(
     // Lower inertia count and shift choice.
     progress(Progress::PhaseStart(Phase::Factor));
     let t = Instant::now();
-    let nu_lo = if lam_lo > 0.0 {
+    // A band edge far below the top of the spectrum (20 Hz vs MHz) cannot have many modes
+    // below it worth a factorization: the upper inertia count then proves completeness of
+    // everything below σ' including the modes below f_min that the search converges anyway.
+    let count_below = lam_lo > LOW_EDGE_FRACTION * lam_scale;
+    let nu_lo = if count_below {
         stats.factorizations += 1;
         inertia(&mut factor, lam_lo)?
     } else {
         n_rigid
     };
-    let elastic_below = nu_lo.saturating_sub(n_rigid);
-    stats.elastic_below_band = elastic_below;
-    let low_shift = lam_lo == 0.0 || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
+    let mut elastic_below = nu_lo.saturating_sub(n_rigid);
+    let low_shift = !count_below || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
     if low_shift {
         let sigma = -lam_lo.max(SHIFT_FLOOR * lam_scale);
         stats.factorizations += 1;
@@ -152,6 +158,10 @@ pub fn solve(
         // Known elastic eigenvalues in [λ_lo, σ'): the returned ones plus converged ones
         // beyond the cap (e.g. the rest of a multiplet split by `max_modes`).
         let in_check = known.lambdas.iter().filter(|&&x| x >= lam_lo && x < sigma_hi).count();
+        if !count_below {
+            elastic_below = known.lambdas.iter().filter(|&&x| x < lam_lo).count();
+        }
+        stats.elastic_below_band = elastic_below;
         let found = n_rigid + elastic_below + in_check.max(lams.len());
         stats.inertia_expected = nu_hi;
         stats.inertia_found = found;
