@@ -15,13 +15,13 @@
 //! [`render_reference`] implements the same recurrence in double precision.
 
 /// Modes per register tile.
-pub const TILE: usize = 32;
+pub const TILE: usize = 64;
 /// Width of the per-sample partial sums.
 pub const LANES: usize = 16;
 /// Modes per chunk: the unit of parallel work and of the fixed summation order.
 pub const CHUNK: usize = 1024;
 
-const _: () = assert!(TILE == 2 * LANES && CHUNK.is_multiple_of(TILE));
+const _: () = assert!(TILE == 4 * LANES && CHUNK.is_multiple_of(TILE));
 
 /// Which f32 kernel variant runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,7 +83,7 @@ fn tile<M: MulAdd>(ur: &mut [f32], ui: &mut [f32], pr: &[f32], pi: &[f32], lanes
     for acc in lanes.iter_mut() {
         let mut sum = *acc;
         for l in 0..LANES {
-            sum[l] += r[l] + r[l + LANES];
+            sum[l] += (r[l] + r[l + LANES]) + (r[l + 2 * LANES] + r[l + 3 * LANES]);
         }
         *acc = sum;
         for l in 0..TILE {
@@ -121,56 +121,51 @@ mod x86 {
     #[target_feature(enable = "avx512f")]
     pub(super) fn tile_avx512(ur: &mut [f32], ui: &mut [f32], pr: &[f32], pi: &[f32], lanes: &mut [LaneBuf]) {
         assert!(ur.len() == TILE && ui.len() == TILE && pr.len() == TILE && pi.len() == TILE);
-        // SAFETY: every pointer below addresses TILE = 32 valid f32 (asserted
-        // above) or one LaneBuf of 16 f32; unaligned loads/stores are used.
+        // SAFETY: every pointer below addresses TILE = 64 valid f32 (asserted
+        // above, 4 vectors of 16) or one LaneBuf of 16 f32; unaligned loads/stores.
         unsafe {
-            let (mut r0, mut r1) = (_mm512_loadu_ps(ur.as_ptr()), _mm512_loadu_ps(ur.as_ptr().add(16)));
-            let (mut i0, mut i1) = (_mm512_loadu_ps(ui.as_ptr()), _mm512_loadu_ps(ui.as_ptr().add(16)));
-            let (pr0, pr1) = (_mm512_loadu_ps(pr.as_ptr()), _mm512_loadu_ps(pr.as_ptr().add(16)));
-            let (pi0, pi1) = (_mm512_loadu_ps(pi.as_ptr()), _mm512_loadu_ps(pi.as_ptr().add(16)));
+            let ld = |p: *const f32| std::array::from_fn::<__m512, 4, _>(|k| _mm512_loadu_ps(p.add(16 * k)));
+            let (mut r, mut i) = (ld(ur.as_ptr()), ld(ui.as_ptr()));
+            let (p, q) = (ld(pr.as_ptr()), ld(pi.as_ptr()));
             for acc in lanes.iter_mut() {
                 let a = _mm512_loadu_ps(acc.as_ptr());
-                _mm512_storeu_ps(acc.as_mut_ptr(), _mm512_add_ps(a, _mm512_add_ps(r0, r1)));
-                let nr0 = _mm512_fmsub_ps(pr0, r0, _mm512_mul_ps(pi0, i0));
-                let ni0 = _mm512_fmadd_ps(pr0, i0, _mm512_mul_ps(pi0, r0));
-                let nr1 = _mm512_fmsub_ps(pr1, r1, _mm512_mul_ps(pi1, i1));
-                let ni1 = _mm512_fmadd_ps(pr1, i1, _mm512_mul_ps(pi1, r1));
-                (r0, i0, r1, i1) = (nr0, ni0, nr1, ni1);
+                let fold = _mm512_add_ps(_mm512_add_ps(r[0], r[1]), _mm512_add_ps(r[2], r[3]));
+                _mm512_storeu_ps(acc.as_mut_ptr(), _mm512_add_ps(a, fold));
+                for k in 0..4 {
+                    let nr = _mm512_fmsub_ps(p[k], r[k], _mm512_mul_ps(q[k], i[k]));
+                    let ni = _mm512_fmadd_ps(p[k], i[k], _mm512_mul_ps(q[k], r[k]));
+                    (r[k], i[k]) = (nr, ni);
+                }
             }
-            _mm512_storeu_ps(ur.as_mut_ptr(), r0);
-            _mm512_storeu_ps(ur.as_mut_ptr().add(16), r1);
-            _mm512_storeu_ps(ui.as_mut_ptr(), i0);
-            _mm512_storeu_ps(ui.as_mut_ptr().add(16), i1);
+            for k in 0..4 {
+                _mm512_storeu_ps(ur.as_mut_ptr().add(16 * k), r[k]);
+                _mm512_storeu_ps(ui.as_mut_ptr().add(16 * k), i[k]);
+            }
         }
     }
 
     #[target_feature(enable = "avx2,fma")]
     pub(super) fn tile_avx2(ur: &mut [f32], ui: &mut [f32], pr: &[f32], pi: &[f32], lanes: &mut [LaneBuf]) {
         assert!(ur.len() == TILE && ui.len() == TILE && pr.len() == TILE && pi.len() == TILE);
-        // SAFETY: as in `tile_avx512`: 4 × 8 f32 per mode slice, 2 × 8 per LaneBuf.
+        // SAFETY: as in `tile_avx512`: 8 × 8 f32 per mode slice, 2 × 8 per LaneBuf.
         unsafe {
-            let ld = |p: *const f32| {
-                [
-                    _mm256_loadu_ps(p),
-                    _mm256_loadu_ps(p.add(8)),
-                    _mm256_loadu_ps(p.add(16)),
-                    _mm256_loadu_ps(p.add(24)),
-                ]
-            };
+            let ld = |p: *const f32| std::array::from_fn::<__m256, 8, _>(|k| _mm256_loadu_ps(p.add(8 * k)));
             let (mut r, mut i) = (ld(ur.as_ptr()), ld(ui.as_ptr()));
             let (p, q) = (ld(pr.as_ptr()), ld(pi.as_ptr()));
             for acc in lanes.iter_mut() {
-                let lo = _mm256_loadu_ps(acc.as_ptr());
-                let hi = _mm256_loadu_ps(acc.as_ptr().add(8));
-                _mm256_storeu_ps(acc.as_mut_ptr(), _mm256_add_ps(lo, _mm256_add_ps(r[0], r[2])));
-                _mm256_storeu_ps(acc.as_mut_ptr().add(8), _mm256_add_ps(hi, _mm256_add_ps(r[1], r[3])));
-                for k in 0..4 {
+                for h in 0..2 {
+                    let a = _mm256_loadu_ps(acc.as_ptr().add(8 * h));
+                    let fold =
+                        _mm256_add_ps(_mm256_add_ps(r[h], r[h + 2]), _mm256_add_ps(r[h + 4], r[h + 6]));
+                    _mm256_storeu_ps(acc.as_mut_ptr().add(8 * h), _mm256_add_ps(a, fold));
+                }
+                for k in 0..8 {
                     let nr = _mm256_fmsub_ps(p[k], r[k], _mm256_mul_ps(q[k], i[k]));
                     let ni = _mm256_fmadd_ps(p[k], i[k], _mm256_mul_ps(q[k], r[k]));
                     (r[k], i[k]) = (nr, ni);
                 }
             }
-            for k in 0..4 {
+            for k in 0..8 {
                 _mm256_storeu_ps(ur.as_mut_ptr().add(8 * k), r[k]);
                 _mm256_storeu_ps(ui.as_mut_ptr().add(8 * k), i[k]);
             }
