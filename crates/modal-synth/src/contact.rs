@@ -21,15 +21,15 @@
 use crate::complex::C64;
 use std::f64::consts::PI;
 
-/// Default contact time of a strike [s]: 0.1 ms, a hard mallet. Fixed (not
+/// Default contact time of a strike \[s\]: 0.1 ms, a hard mallet. Fixed (not
 /// speed dependent) so the output stays linear in the impulse.
 pub const DEFAULT_CONTACT_TIME_S: f64 = 1e-4;
 
-/// Longest accepted contact time [s].
+/// Longest accepted contact time \[s\].
 pub const MAX_CONTACT_TIME_S: f64 = 0.1;
 
 /// Centred half-sine contact spectrum `C(sτ)` for complex frequency `s` [1/s]
-/// and contact time `tau_s` [s] (see module doc). Returns 0 when the value
+/// and contact time `tau_s` \[s\] (see module doc). Returns 0 when the value
 /// overflows (a mode that decays completely during a long contact).
 pub fn half_sine_spectrum(s: C64, tau_s: f64) -> C64 {
     if tau_s == 0.0 {
@@ -62,7 +62,7 @@ pub fn half_sine_spectrum(s: C64, tau_s: f64) -> C64 {
     }
 }
 
-/// Hertz contact time [s] of an impact with effective mass `m_eff_kg`,
+/// Hertz contact time \[s\] of an impact with effective mass `m_eff_kg`,
 /// effective radius `r_eff_m`, effective modulus `e_star_pa` and normal
 /// approach speed `speed_m_s`: `2.8683 (m²/(R E*² v))^{1/5}`.
 /// Returns `None` unless all inputs are finite and positive.
@@ -74,7 +74,7 @@ pub fn hertz_contact_time(m_eff_kg: f64, r_eff_m: f64, e_star_pa: f64, speed_m_s
     Some(2.8683 * (m_eff_kg * m_eff_kg / (r_eff_m * e_star_pa * e_star_pa * speed_m_s)).powf(0.2))
 }
 
-/// Effective Hertz modulus `E* = 1 / ((1−ν₁²)/E₁ + (1−ν₂²)/E₂)` [Pa].
+/// Effective Hertz modulus `E* = 1 / ((1−ν₁²)/E₁ + (1−ν₂²)/E₂)` \[Pa\].
 /// Pass `f64::INFINITY` for a rigid second body.
 pub fn effective_modulus(e1_pa: f64, nu1: f64, e2_pa: f64, nu2: f64) -> f64 {
     1.0 / ((1.0 - nu1 * nu1) / e1_pa + (1.0 - nu2 * nu2) / e2_pa)

@@ -24,11 +24,11 @@ pub enum SynthError {
         point[0], point[1], point[2]
     )]
     PointFarFromSurface {
-        /// The query point [m].
+        /// The query point \[m\].
         point: [f64; 3],
-        /// Distance to the nearest surface point [m].
+        /// Distance to the nearest surface point \[m\].
         distance: f64,
-        /// Largest accepted distance [m].
+        /// Largest accepted distance \[m\].
         limit: f64,
     },
     /// The bank has modes but no surface triangles to strike.

@@ -4,7 +4,7 @@
 //! Modal coordinates follow the bank: mass-normalized shapes `φ_i` [1/√kg],
 //! so an impulse `j` [N·s] at surface point `p` gives mode `i` the modal
 //! velocity `a_i = φ_i(p)·j` [√kg·m/s] and the surface displacement at `x` is
-//! `u(x, t) = Σ_i φ_i(x) q_i(t)` [m].
+//! `u(x, t) = Σ_i φ_i(x) q_i(t)` \[m\].
 
 use crate::error::SynthError;
 use crate::surface::{node_weights, SurfaceLocator, SurfacePoint};
@@ -18,7 +18,7 @@ pub const MAX_SNAP_FRACTION: f64 = 0.1;
 /// Per-mode data and the surface of one bank, validated.
 #[derive(Clone, Debug)]
 pub struct SynthModel {
-    /// Undamped natural frequencies [Hz].
+    /// Undamped natural frequencies \[Hz\].
     pub frequencies_hz: Vec<f64>,
     /// Decay rates d [1/s].
     pub decay_rates: Vec<f64>,
@@ -83,7 +83,7 @@ impl SynthModel {
         &self.surface
     }
 
-    /// Nearest surface point to `p` [m]. Errors when `p` is not finite, the
+    /// Nearest surface point to `p` \[m\]. Errors when `p` is not finite, the
     /// surface is empty, or `p` lies farther than [`MAX_SNAP_FRACTION`] of the
     /// bounding-box diagonal from the surface.
     pub fn locate(&self, p: [f64; 3]) -> Result<SurfacePoint, SynthError> {

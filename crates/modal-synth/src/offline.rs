@@ -14,11 +14,11 @@ use crate::surface::SurfacePoint;
 use crate::voice::{ModalVoice, VoiceStats, BLOCK};
 use modal_bank::ModeBank;
 
-/// Longest offline render [s] (bounds the output allocation).
+/// Longest offline render \[s\] (bounds the output allocation).
 pub const MAX_DURATION_S: f64 = 3600.0;
-/// Fade-out applied when the automatic duration hits its cap [s].
+/// Fade-out applied when the automatic duration hits its cap \[s\].
 pub const FADE_S: f64 = 0.05;
-/// Shortest automatic duration [s].
+/// Shortest automatic duration \[s\].
 pub const MIN_AUTO_DURATION_S: f64 = 0.1;
 /// Decay (dB below the peak envelope) at which the automatic duration ends.
 pub const AUTO_DECAY_DB: f64 = 60.0;
@@ -26,13 +26,13 @@ pub const AUTO_DECAY_DB: f64 = 60.0;
 /// One strike of an offline render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Strike {
-    /// Contact start [s].
+    /// Contact start \[s\].
     pub time_s: f64,
-    /// Point [m] in the bank frame, snapped to the surface.
+    /// Point \[m\] in the bank frame, snapped to the surface.
     pub at: [f64; 3],
     /// Impulse vector [N·s].
     pub impulse_ns: [f64; 3],
-    /// Contact time [s] (0 = ideal impulse).
+    /// Contact time \[s\] (0 = ideal impulse).
     pub contact_time_s: f64,
 }
 
@@ -50,7 +50,7 @@ pub enum RenderLength {
     Fixed(f64),
     /// Until the output decayed by 60 dB (module doc), at most `cap_s`.
     Auto {
-        /// Longest duration [s].
+        /// Longest duration \[s\].
         cap_s: f64,
     },
 }
@@ -60,11 +60,11 @@ pub enum RenderLength {
 pub struct Rendered {
     /// Mono samples (output units, m/s for the default contact microphone).
     pub samples: Vec<f32>,
-    /// Sample rate [Hz].
+    /// Sample rate \[Hz\].
     pub sample_rate: f64,
     /// The surface point each strike snapped to.
     pub points: Vec<SurfacePoint>,
-    /// Rendered duration [s].
+    /// Rendered duration \[s\].
     pub duration_s: f64,
     /// True when the automatic duration hit its cap (a fade-out was applied).
     pub capped: bool,
@@ -120,7 +120,7 @@ pub fn render_strikes(
     })
 }
 
-/// Time [s] at which `voice`'s output (current state plus pending impulses)
+/// Time \[s\] at which `voice`'s output (current state plus pending impulses)
 /// has decayed by [`AUTO_DECAY_DB`], at least [`MIN_AUTO_DURATION_S`] and at
 /// most `cap_s`; the flag tells whether the cap was hit.
 pub fn auto_duration(voice: &mut ModalVoice, cap_s: f64) -> (f64, bool) {

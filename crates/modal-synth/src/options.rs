@@ -2,11 +2,11 @@
 
 use crate::error::SynthError;
 
-/// Lowest accepted sample rate [Hz].
+/// Lowest accepted sample rate \[Hz\].
 pub const MIN_SAMPLE_RATE: f64 = 8_000.0;
-/// Highest accepted sample rate [Hz].
+/// Highest accepted sample rate \[Hz\].
 pub const MAX_SAMPLE_RATE: f64 = 192_000.0;
-/// Modes whose damped frequency is below this are not synthesized [Hz].
+/// Modes whose damped frequency is below this are not synthesized \[Hz\].
 pub const MIN_FREQUENCY_HZ: f64 = 20.0;
 /// Modes whose damped frequency is at or above this fraction of the sample
 /// rate are not synthesized (no aliasing).
@@ -18,7 +18,7 @@ pub enum OutputQuantity {
     /// `y = Σ g_i q̇_i`: with contact-mic gains, normal surface velocity [m/s].
     #[default]
     Velocity,
-    /// `y = Σ g_i q_i`: with contact-mic gains, normal surface displacement [m].
+    /// `y = Σ g_i q_i`: with contact-mic gains, normal surface displacement \[m\].
     Displacement,
 }
 
@@ -27,10 +27,10 @@ pub enum OutputQuantity {
 pub enum OutputGain {
     /// Contact microphone: `g_i = φ_i(p_mic)·n(p_mic)` [1/√kg], the normal
     /// surface motion at a point. `at: None` puts the microphone at the first
-    /// struck point (the first `add_impulse` call); `Some(x)` snaps `x` [m] to
+    /// struck point (the first `add_impulse` call); `Some(x)` snaps `x` \[m\] to
     /// the surface.
     ContactMic {
-        /// Microphone position [m], or `None` for the first struck point.
+        /// Microphone position \[m\], or `None` for the first struck point.
         at: Option<[f64; 3]>,
     },
     /// Radiation/listener proxy: `g_i` = area-weighted RMS over the surface of
@@ -63,7 +63,7 @@ pub enum Kernel {
 /// Options of a [`crate::ModalVoice`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SynthOptions {
-    /// Sample rate [Hz], 8 000 ..= 192 000.
+    /// Sample rate \[Hz\], 8 000 ..= 192 000.
     pub sample_rate: f64,
     /// A mode leaves the active set when its envelope falls this many dB
     /// below the loudest active mode (negative, e.g. −100); `None` disables

@@ -24,11 +24,11 @@ pub struct SurfacePoint {
     pub triangle: usize,
     /// Barycentric coordinates w.r.t. the triangle's corners (sum 1, each ≥ 0).
     pub bary: [f64; 3],
-    /// The surface point [m].
+    /// The surface point \[m\].
     pub position: [f64; 3],
     /// Outward unit normal of the triangle (zero for a degenerate triangle).
     pub normal: [f64; 3],
-    /// Distance from the query point to `position` [m].
+    /// Distance from the query point to `position` \[m\].
     pub distance: f64,
 }
 
@@ -217,7 +217,7 @@ impl SurfaceLocator {
         locator
     }
 
-    /// Diagonal of the surface's bounding box [m].
+    /// Diagonal of the surface's bounding box \[m\].
     pub fn bbox_diagonal(&self) -> f64 {
         self.bbox_diagonal
     }

@@ -55,7 +55,7 @@ pub const REANCHOR_BLOCKS: u64 = 16;
 pub const ABSOLUTE_FLOOR: f64 = 1e-30;
 /// Active modes from which chunks are rendered in parallel.
 pub const PARALLEL_MIN_MODES: usize = 2 * CHUNK;
-/// Largest accepted event time [s] (about 31 years).
+/// Largest accepted event time \[s\] (about 31 years).
 pub const MAX_TIME_S: f64 = 1e9;
 
 /// Output weight `W` with `Re(W z) = g q̇` (velocity) or `g q` (displacement),
@@ -70,7 +70,7 @@ fn weight(quantity: OutputQuantity, s: C64, g: f64) -> C64 {
 /// Where an impulse lands.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ImpactPoint {
-    /// A position [m] in the bank's frame, snapped to the nearest surface point.
+    /// A position \[m\] in the bank's frame, snapped to the nearest surface point.
     Position([f64; 3]),
     /// An already located surface point.
     Surface(SurfacePoint),
@@ -115,7 +115,7 @@ pub struct VoiceStats {
 pub struct ExcitedMode {
     /// Index of the mode in the bank.
     pub mode: usize,
-    /// Damped frequency [Hz].
+    /// Damped frequency \[Hz\].
     pub frequency_hz: f64,
     /// Decay rate d [1/s].
     pub decay_rate: f64,
@@ -126,7 +126,7 @@ pub struct ExcitedMode {
 
 #[derive(Clone, Debug)]
 struct Event {
-    /// Force centroid time [s].
+    /// Force centroid time \[s\].
     tc: f64,
     /// First sample at or after `tc`.
     sample: u64,
@@ -318,7 +318,7 @@ impl ModalVoice {
         &self.model
     }
 
-    /// Sample rate [Hz].
+    /// Sample rate \[Hz\].
     pub fn sample_rate(&self) -> f64 {
         self.fs
     }
@@ -358,7 +358,7 @@ impl ModalVoice {
     }
 
     /// Schedules an impulse `impulse_ns` [N·s] (bank frame) at `at`, with the
-    /// contact starting at `time_s` [s] and lasting `contact_time_s` [s]
+    /// contact starting at `time_s` \[s\] and lasting `contact_time_s` \[s\]
     /// (0 = ideal impulse; the response is applied at the force centroid
     /// `time_s + contact_time_s/2`, see `contact`). Returns the struck surface
     /// point. The first call fixes a `ContactMic { at: None }` microphone.
@@ -604,7 +604,7 @@ impl ModalVoice {
         self.synced = Some(g);
     }
 
-    /// Moves the render position to `time_s` [s] (rounded up to a sample) in
+    /// Moves the render position to `time_s` \[s\] (rounded up to a sample) in
     /// closed form: pending impulses before it are applied to the state
     /// exactly, their output before `time_s` is skipped.
     pub fn jump_to(&mut self, time_s: f64) -> Result<(), SynthError> {

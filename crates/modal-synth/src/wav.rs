@@ -51,7 +51,7 @@ pub struct WavReport {
     pub channels: u16,
     /// Frames (samples per channel).
     pub frames: usize,
-    /// Sample rate [Hz].
+    /// Sample rate \[Hz\].
     pub sample_rate: u32,
     /// Gain that was applied.
     pub gain: f64,
