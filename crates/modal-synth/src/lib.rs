@@ -31,7 +31,10 @@ pub use contact::{
 };
 pub use error::SynthError;
 pub use model::{SynthModel, MAX_SNAP_FRACTION};
-pub use offline::{auto_duration, render_strikes, RenderLength, Rendered, Strike, MAX_DURATION_S};
+pub use offline::{
+    auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,
+    MIN_AUTO_DURATION_S,
+};
 pub use options::{
     check_sample_rate, Kernel, OutputGain, OutputQuantity, SynthOptions, MAX_FREQUENCY_FRACTION,
     MAX_SAMPLE_RATE, MIN_FREQUENCY_HZ, MIN_SAMPLE_RATE,
