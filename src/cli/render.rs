@@ -8,13 +8,12 @@ use anyhow::{Context, Result};
 use modal_bank::{BankCache, ModeBank};
 use modal_precompute::{MeshSource, Request};
 use modal_scene::{BankProvider, BankRequest, ProviderError, Scene};
-use modal_synth::{WavFormat, WavGain};
+use modal_synth::WavFormat;
 
 use super::args::RenderArgs;
 use super::output::{print_json, warn};
 use super::precompute::open_cache;
 use super::progress::Spinner;
-use super::write_atomic;
 
 /// Where the demo is written when no output is given.
 pub const DEMO_OUTPUT: &str = "audio_out/demo.wav";
@@ -121,18 +120,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
     spinner.finish();
     warnings.iter().for_each(|w| warn(w));
     let rendered = rendered.context("render failed")?;
-    let channels: Vec<&[f32]> = rendered.channels.iter().map(Vec::as_slice).collect();
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
-    let wav = modal_synth::write_wav(&out, &channels, rendered.sample_rate, format, WavGain::Fixed(1.0))
-        .with_context(|| format!("cannot write {}", out.display()))?;
+    let wav = modal_scene::write_wav(&rendered, &out, format)?;
     if wav.clipped > 0 {
         warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
     }
     if let Some(path) = &args.events {
-        write_json_file(path, &rendered.events)?;
+        modal_scene::write_events_json(&rendered.events, path)?;
     }
     if let Some(path) = &args.spectrogram {
-        anyhow::bail!("--spectrogram {}: not available yet", path.display());
+        modal_scene::write_spectrogram_png(&rendered.channels, path)?;
     }
     let report = &rendered.report;
     if args.json {
@@ -145,15 +142,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     print_report(report, &out, cached, solved);
     Ok(())
-}
-
-fn write_json_file(path: &Path, value: &impl serde::Serialize) -> Result<()> {
-    write_atomic(path, |tmp| {
-        let file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-        serde_json::to_writer_pretty(file, value)?;
-        Ok(())
-    })
-    .with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, solved: usize) {
