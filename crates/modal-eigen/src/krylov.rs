@@ -69,6 +69,8 @@ pub struct Counters {
     pub restarts: usize,
     /// Block solves.
     pub block_solves: usize,
+    /// Explicit residual checks of candidate Ritz pairs.
+    pub residual_checks: usize,
 }
 
 /// Relative residuals ‖K y − λ M y‖ / (|λ| ‖M y‖) of columns of `y`.
@@ -163,6 +165,7 @@ pub fn search(
             k += p;
             if k >= check_from {
                 if let Some(out) = try_finish(&h, &v, k, p, sigma, gate, cfg, k_mat, m, enough)? {
+                    counters.residual_checks += 1;
                     match out {
                         Finish::Done(o) => {
                             stop = Some(o);
@@ -319,6 +322,7 @@ fn try_finish(
             block_solves: 0,
         })));
     }
-    let f = (1.0 / worst).clamp(1e-3, 0.5);
+    // Aggressive: every failed explicit check costs two sparse products on all candidates.
+    let f = (0.1 / worst).clamp(1e-3, 0.1);
     Ok(Some(Finish::Tighten(f)))
 }

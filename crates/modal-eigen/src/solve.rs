@@ -110,7 +110,7 @@ pub fn solve(
     let below_known = if low_shift { elastic_below } else { 0 };
     let mut wanted = below_known + opts.max_modes;
     let cap = opts.max_modes;
-    let mut counters = Counters { restarts: 0, block_solves: 0 };
+    let mut counters = Counters { restarts: 0, block_solves: 0, residual_checks: 0 };
     let mut searches = 0usize;
     let t_iter = Instant::now();
     let mut check_s = 0.0;
@@ -176,6 +176,7 @@ pub fn solve(
             .fold(0.0, f64::max);
         if nu_hi == found && worst <= 1.0 {
             stats.block_solves = counters.block_solves;
+            stats.residual_checks = counters.residual_checks;
             stats.iterations = counters.restarts;
             stats.check_s = check_s;
             stats.solve_s = t_iter.elapsed().as_secs_f64() - check_s;

@@ -83,6 +83,8 @@ pub struct SolveStats {
     pub factorizations: usize,
     /// Block solves (each `block_size` columns).
     pub block_solves: usize,
+    /// Explicit residual checks of candidate Ritz pairs during the iteration.
+    pub residual_checks: usize,
     /// Krylov–Schur restarts over all searches.
     pub iterations: usize,
     /// Stored entries of the factor L.
