@@ -319,7 +319,7 @@ fn spectrum_scale(
     for j in 0..k.ncols() {
         let mj = diag(m, j);
         if mj <= 0.0 || mj.is_nan() {
-            return Err(EigenError::NotPositiveDefinite { pivot: j });
+            return Err(EigenError::MassNotPositive { dof: j });
         }
         scale = scale.max(diag(k, j) / mj);
     }

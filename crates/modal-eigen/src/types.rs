@@ -236,6 +236,12 @@ pub enum EigenError {
         /// Pivot index in elimination order.
         pivot: usize,
     },
+    /// A diagonal entry of M is not positive (M must be positive definite).
+    #[error("mass matrix diagonal at DOF {dof} is not positive")]
+    MassNotPositive {
+        /// DOF index.
+        dof: usize,
+    },
     /// An indefinite LDLᵀ hit an exactly zero pivot.
     #[error("LDL^T of K - sigma*M hit a zero pivot at {pivot} (sigma = {shift:e})")]
     ZeroPivot {

@@ -126,6 +126,22 @@ fn invalid_input_is_a_typed_error() {
     ));
     let opts = EigenOptions { min_freq_hz: f64::NAN, ..Default::default() };
     assert!(solve(&g.k, &g.m, None, &opts, &mut |_| {}).is_err());
+    // Zero mass at a DOF.
+    let n = g.m.nrows();
+    let t: Vec<_> =
+        (0..n).map(|i| faer::sparse::Triplet::new(i, i, if i == 7 { 0.0 } else { 1e-5 })).collect();
+    let m0 = faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+    assert_eq!(
+        solve(&g.k, &m0, None, &EigenOptions::default(), &mut |_| {}).unwrap_err(),
+        modal_eigen::EigenError::MassNotPositive { dof: 7 }
+    );
+    // NaN in K.
+    let mut k = g.k.clone();
+    k.val_mut()[3] = f64::NAN;
+    assert!(matches!(
+        solve(&k, &g.m, None, &EigenOptions::default(), &mut |_| {}),
+        Err(modal_eigen::EigenError::NonFinite { matrix: "K", .. })
+    ));
     let _ = hz_to_lambda(1.0);
 }
 
