@@ -9,11 +9,13 @@
 //! `J_{k−1} = 0` when the pair did not touch in the previous step) excites,
 //! and only when it exceeds [`SUSTAIN_DEADBAND`] × `J_{k−1}` (solver jitter of
 //! a resting contact) and [`MIN_IMPULSE_NS`], and only when the contact
-//! closes at [`MIN_APPROACH_M_S`] or faster: the contact point of a resting,
-//! rolling or rocking body has no normal approach speed, whereas an impact
-//! (also a second corner landing while the first still touches) has. The
-//! faceted convex hull of a curved body (a bowl) rocks across facet edges at
-//! a few cm/s; the threshold treats that as the rolling it stands for. The rise is shared among the
+//! closes fast enough: [`MIN_APPROACH_M_S`] for a new contact,
+//! [`MIN_APPROACH_CONTINUING_M_S`] for a rise on a contact that already
+//! touched (within [`RECONTACT_WINDOW_S`]). The contact point of a resting, rolling or rocking body has no
+//! normal approach speed, whereas an impact (also a second corner landing
+//! while the first still touches, at ~1 m/s) has. The faceted convex hull of
+//! a curved body (a bowl) rocks across facet edges at up to ~0.1 m/s; the
+//! continuing-contact threshold treats that as the rolling it stands for. The rise is shared among the
 //! pair's points in proportion to their impulse: point `i` with impulse
 //! vector `p_i` (normal + friction) strikes with `(ΔJ_k / J_k) · p_i`. A new
 //! impact therefore sounds with its full impulse, a resting or rolling
@@ -41,8 +43,15 @@ use crate::physics::{ContactSide, PairContacts};
 /// A rise below this fraction of the previous step's impulse is jitter of a
 /// sustained contact, not an impact.
 pub const SUSTAIN_DEADBAND: f64 = 0.25;
-/// Contacts closing slower than this never strike [m/s].
+/// New contacts closing slower than this never strike [m/s].
 pub const MIN_APPROACH_M_S: f64 = 0.05;
+/// A rise on a contact that already touched strikes only when some point
+/// closes at least this fast [m/s] (a second corner landing does; a body
+/// rocking across the facets of its hull does not).
+pub const MIN_APPROACH_CONTINUING_M_S: f64 = 0.25;
+/// A pair that touched within this time counts as a continuing contact [s]
+/// (a hull rocking across facets loses contact for a step or two).
+pub const RECONTACT_WINDOW_S: f64 = 0.02;
 /// Rises below this impulse are ignored [N·s].
 pub const MIN_IMPULSE_NS: f64 = 1e-9;
 /// Shortest contact time [s].
@@ -96,8 +105,11 @@ pub fn hertz_contact_time(a: &ContactSide, b: &ContactSide, v: f64) -> f64 {
 /// Turns per-step contacts into strikes, remembering each pair's last impulse.
 #[derive(Default)]
 pub(crate) struct Exciter {
+    /// Per pair: total normal impulse of the previous step.
     previous: HashMap<(u32, u32), f64>,
     current: HashMap<(u32, u32), f64>,
+    /// Per pair: start time of the last step it touched in [s].
+    last_touch: HashMap<(u32, u32), f64>,
 }
 
 /// What one step saw.
@@ -137,17 +149,20 @@ impl Exciter {
         for pair in pairs {
             let total: f64 = pair.points.iter().map(|p| p.normal_impulse).sum();
             self.current.insert(pair.key, total);
+            let recent_touch = self.last_touch.insert(pair.key, t0);
             let before = self.previous.get(&pair.key).copied().unwrap_or(0.0);
             let rise = total - before;
             if rise <= MIN_IMPULSE_NS || rise <= SUSTAIN_DEADBAND * before || total <= 0.0 {
                 continue;
             }
             let approach = pair.points.iter().map(|p| p.approach_m_s).fold(0.0, f64::max);
-            if approach < MIN_APPROACH_M_S {
+            let fresh = before == 0.0;
+            let recent = recent_touch.is_some_and(|t| t0 - t <= RECONTACT_WINDOW_S + 0.5 * dt);
+            let gate = if recent { MIN_APPROACH_CONTINUING_M_S } else { MIN_APPROACH_M_S };
+            if approach < gate {
                 continue;
             }
             let share = rise / total;
-            let fresh = before == 0.0;
             let time = if fresh {
                 let gap = pair.points.iter().map(|p| p.separation_m).fold(f64::INFINITY, f64::min);
                 let lead = if approach > 0.0 && gap > 0.0 { (gap / approach).min(dt) } else { 0.0 };

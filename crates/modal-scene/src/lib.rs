@@ -23,8 +23,8 @@ mod validate;
 
 pub use error::SceneError;
 pub use excite::{
-    hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_APPROACH_M_S, MIN_CONTACT_TIME_S,
-    MIN_IMPULSE_NS, SUSTAIN_DEADBAND,
+    hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_APPROACH_CONTINUING_M_S,
+    MIN_APPROACH_M_S, MIN_CONTACT_TIME_S, MIN_IMPULSE_NS, RECONTACT_WINDOW_S, SUSTAIN_DEADBAND,
 };
 pub use listener::{MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
 pub use material::{preset_names, resolve_material};
