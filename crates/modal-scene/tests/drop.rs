@@ -96,3 +96,21 @@ fn harder_throw_is_louder() {
     eprintln!("gentle {pa} hard {pb}");
     assert!(pb > 2.0 * pa, "gentle peak {pa}, hard peak {pb}");
 }
+
+#[test]
+fn impact_times_are_resolved_within_a_physics_step() {
+    // Fall times 0.14278 s and 0.14307 s differ by 0.29 ms, less than a third
+    // of the 1 ms physics step: the events must still tell them apart.
+    let times: Vec<f64> = [0.1, 0.1004]
+        .iter()
+        .map(|h| {
+            let scene = drop_scene(*h, 0.0, 0.2, [0.0, 0.3, 0.6]);
+            let out =
+                render(&scene, &mut provider(), &RenderOptions { collect_events: true }).expect("render");
+            out.events.first().expect("an impact").time_s
+        })
+        .collect();
+    let expected = (2.0 * 0.1004 / 9.81f64).sqrt() - (2.0 * 0.1 / 9.81f64).sqrt();
+    let got = times[1] - times[0];
+    assert!((got - expected).abs() < 0.1e-3, "onset difference {got} s, expected {expected} s");
+}
