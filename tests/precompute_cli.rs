@@ -81,7 +81,7 @@ fn retune_matches_a_fresh_solve() {
     .json();
     let fresh =
         precompute(dir.path(), "fresh.bank", &["--youngs", "70e9", "--poisson", "0.3", "--density", "2700"]);
-    let ratio = ((70e9 / 200e9) / (2700.0 / 7850.0) as f64).sqrt();
+    let ratio = ((70e9_f64 / 200e9) / (2700.0 / 7850.0)).sqrt();
     for ((r, f), s) in frequencies(&retuned).iter().zip(frequencies(&fresh)).zip(frequencies(&steel)) {
         assert!((r / f - 1.0).abs() < 1e-7, "retuned {r} vs fresh {f}");
         assert!((r / (s * ratio) - 1.0).abs() < 1e-12);
