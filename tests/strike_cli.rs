@@ -1,0 +1,96 @@
+//! End-to-end tests of `modal strike`: a real bank struck through the CLI,
+//! and every bad input of issue 4 giving a clear error and no WAV.
+
+mod common;
+use common::*;
+
+/// A steel bar bank (lightly damped) in `dir/bar.bank`.
+fn bar_bank(dir: &std::path::Path) {
+    let bar = example("bar_p1.msh");
+    let mut args = vec!["precompute", bar.to_str().unwrap(), "-o", "bar.bank", "--modes", "12"];
+    args.extend(STEEL);
+    args.extend(["--alpha", "5", "--beta", "3e-8"]);
+    modal(dir, &args).ok();
+}
+
+fn wav_samples(path: &std::path::Path) -> Vec<i16> {
+    hound::WavReader::open(path).unwrap().into_samples::<i16>().map(Result::unwrap).collect()
+}
+
+#[test]
+fn strike_writes_a_wav_that_is_linear_in_the_impulse() {
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let strike = |impulse: &str, out: &str| {
+        modal(
+            dir.path(),
+            &[
+                "strike",
+                "bar.bank",
+                "--at",
+                "0.05,0.01,0.01",
+                "--impulse",
+                impulse,
+                "--duration",
+                "0.5",
+                "--rate",
+                "44100",
+                "-o",
+                out,
+                "--json",
+            ],
+        )
+        .ok()
+        .json()
+    };
+    let one = strike("0.002", "one.wav");
+    let two = strike("0.004", "two.wav");
+    assert_eq!(one["clipped_samples"], 0);
+    assert!((two["peak"].as_f64().unwrap() / one["peak"].as_f64().unwrap() - 2.0).abs() < 1e-3);
+    assert_eq!(one["sample_rate"], 44100);
+    assert!((one["duration_s"].as_f64().unwrap() - 0.5).abs() < 1e-9);
+    // The struck point lies on the bar's top face.
+    assert!(one["strikes"][0]["distance_m"].as_f64().unwrap() < 1e-9);
+    assert!(!one["top_modes"].as_array().unwrap().is_empty());
+    let (a, b) = (wav_samples(&dir.path().join("one.wav")), wav_samples(&dir.path().join("two.wav")));
+    assert_eq!(a.len(), 22050);
+    assert!(a.iter().any(|&s| s.abs() > 100), "audible");
+    // 16-bit quantization allows ±1 LSB after doubling.
+    assert!(
+        a.iter().zip(&b).all(|(&x, &y)| (2 * x as i32 - y as i32).abs() <= 2),
+        "doubling the impulse doubles the output"
+    );
+    // Default duration: until decayed by 60 dB.
+    let auto =
+        modal(dir.path(), &["strike", "bar.bank", "--at", "0.05,0.01,0.01", "-o", "auto.wav", "--json"])
+            .ok()
+            .json();
+    assert!(auto["duration_s"].as_f64().unwrap() > 0.5);
+}
+
+#[test]
+fn bad_strikes_fail_cleanly_without_output() {
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let at = ["--at", "0.05,0.01,0.01"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["strike", "missing.bank", at[0], at[1], "-o", "x.wav"], "missing.bank"),
+        (vec!["strike", "bar.bank", "--at", "5,5,5", "-o", "x.wav"], "from the surface"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--impulse", "nan", "-o", "x.wav"], "impulse"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--rate", "0", "-o", "x.wav"], "sample rate"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--duration", "-1", "-o", "x.wav"], "duration"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--time", "1", "--time", "2", "-o", "x.wav"], "--time"),
+    ];
+    for (args, needle) in cases {
+        modal(dir.path(), &args).fails_with(needle);
+        assert!(!dir.path().join("x.wav").exists(), "no partial WAV for {args:?}");
+    }
+    // A bank with one flipped bit in its tensor data fails its checksum.
+    let mut bytes = std::fs::read(dir.path().join("bar.bank")).unwrap();
+    let last = bytes.len() - 7;
+    bytes[last] ^= 0x10;
+    std::fs::write(dir.path().join("bad.bank"), bytes).unwrap();
+    modal(dir.path(), &["strike", "bad.bank", at[0], at[1], "-o", "x.wav"]).fails_with("checksum");
+    assert!(!dir.path().join("x.wav").exists());
+    assert!(files_in(dir.path()).iter().all(|f| !f.ends_with(".tmp")));
+}
