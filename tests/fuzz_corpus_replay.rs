@@ -87,7 +87,7 @@ fn corpus_and_mutants_never_panic() {
             run_target(&target, &seed);
             // Large seeds get fewer mutants so the test stays quick in debug builds.
             let mutants = if seed.len() > 10_000 { 50 } else { 1000 };
-            let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ (k as u64 + 1) * 7919);
+            let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ ((k as u64 + 1) * 7919));
             for _ in 0..mutants {
                 run_target(&target, &mutate(&seed, &mut rng));
             }
