@@ -52,6 +52,9 @@ fn main() {
     if let Ok(f) = std::env::var("MAXF") {
         opts.max_freq_hz = f.parse().expect("MAXF");
     }
+    if let Ok(t) = std::env::var("THREADS") {
+        opts.threads = t.parse().expect("THREADS");
+    }
     if let Ok(b) = std::env::var("BLOCK") {
         opts.block_size = b.parse().expect("BLOCK");
     }
