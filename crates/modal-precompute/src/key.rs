@@ -35,7 +35,7 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
         .add_f64("max_freq_hz", request.max_freq_hz)
         .add_u64("max_modes", request.max_modes as u64)
         .add_str("fix_box", &format!("{:?}", request.fix_box))
-        .add_str("cell", &format!("{:?}", request.surface.cell))
+        .add_str("mesher", &request.surface.tet_options().cache_key_fields())
         .add_str("part", &format!("{:?}", request.surface.part));
     Ok(key.finish())
 }

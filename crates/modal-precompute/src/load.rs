@@ -30,6 +30,13 @@ pub struct SurfaceMeshing {
     pub part: Option<String>,
 }
 
+impl SurfaceMeshing {
+    /// The mesher options these settings stand for.
+    pub fn tet_options(&self) -> modal_tetra::TetOptions {
+        modal_tetra::TetOptions { cell: self.cell, ..Default::default() }
+    }
+}
+
 /// A checked tet mesh and what was found on the way.
 #[derive(Clone, Debug)]
 pub struct LoadedMesh {
@@ -63,8 +70,7 @@ pub fn load_mesh(
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
             warnings.extend(report.warnings.iter().cloned());
-            let options = modal_tetra::TetOptions { cell: surface.cell, ..Default::default() };
-            let (mesh, _) = modal_tetra::tetrahedralize(&surf, &options)?;
+            let (mesh, _) = modal_tetra::tetrahedralize(&surf, &surface.tet_options())?;
             mesh
         }
         MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,

@@ -93,7 +93,14 @@ pub fn write_obj(surface: &TriSurface, mut out: impl Write) -> std::io::Result<(
     };
     for (name, range) in parts {
         writeln!(out, "o {name}")?;
-        for t in &surface.triangles[range] {
+        let triangles = surface.triangles.get(range.clone()).ok_or_else(|| {
+            let n = surface.triangles.len();
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("part '{name}' spans triangles {range:?} but the surface has {n}"),
+            )
+        })?;
+        for t in triangles {
             writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
         }
     }

@@ -11,7 +11,6 @@ use modal_fem::{assemble, node_parts, rigid_body_fields, Material};
 use modal_tetra::{read_surface, shapes, tetrahedralize, TetOptions};
 
 #[test]
-#[ignore = "P2 eigen-solve of ≈ 85 k DOF (tens of seconds on a loaded machine)"]
 fn issue_6_icosphere_default_mesh_first_27_modes_within_1_5_percent_of_lamb() {
     let path = common::temp_obj(&shapes::icosphere(0.05, 4));
     let (surface, _) = read_surface(&path, 1.0, None).unwrap();
