@@ -134,3 +134,40 @@ fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
     let nodes = std::fs::read_to_string(dir.path().join("m/nodes.csv")).unwrap();
     assert_eq!(nodes.lines().count() - 1, header[0] / 3);
 }
+
+#[test]
+fn generated_meshes_are_written_and_read_back() {
+    let dir = temp_dir();
+    let shapes: [&[&str]; 5] = [
+        &["box", "--size", "0.1,0.02,0.01", "--h", "0.01"],
+        &["cylinder", "--radius", "0.02", "--length", "0.1", "--h", "0.01"],
+        &["tube", "--inner-radius", "0.015", "--outer-radius", "0.02", "--length", "0.1", "--h", "0.005"],
+        &["sphere", "--radius", "0.05", "--h", "0.02", "--order", "2"],
+        &["bowl", "--radius", "0.06", "--thickness", "0.005", "--h", "0.01"],
+    ];
+    for shape in shapes {
+        let mut args = vec!["mesh"];
+        args.extend(shape);
+        args.extend(["-o", "shape.msh", "--json"]);
+        let written = modal(dir.path(), &args).ok().json();
+        assert!(written["tets"].as_u64().unwrap() > 0);
+        let mut solve = vec![
+            "precompute",
+            "shape.msh",
+            "-o",
+            "shape.bank",
+            "--modes",
+            "3",
+            "--max-freq",
+            "1e6",
+            "--no-cache",
+            "--json",
+        ];
+        solve.extend(STEEL);
+        let json = modal(dir.path(), &solve).ok().json();
+        assert_eq!(json["rigid_modes_removed"], 6, "{shape:?}");
+        assert_eq!(json["modes"].as_array().unwrap().len(), 3, "{shape:?}");
+    }
+    modal(dir.path(), &["mesh", "sphere", "--radius", "-1", "-o", "bad.msh"]).fails_with("radius");
+    assert!(!dir.path().join("bad.msh").exists());
+}

@@ -94,10 +94,10 @@ pub enum MeshShape {
     /// Solid cylinder along z.
     Cylinder {
         /// Radius [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         radius: f64,
         /// Length [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         length: f64,
         #[command(flatten)]
         common: GenerateArgs,
@@ -105,13 +105,13 @@ pub enum MeshShape {
     /// Tube (hollow cylinder) along z.
     Tube {
         /// Inner radius [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         inner_radius: f64,
         /// Outer radius [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         outer_radius: f64,
         /// Length [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         length: f64,
         #[command(flatten)]
         common: GenerateArgs,
@@ -119,7 +119,7 @@ pub enum MeshShape {
     /// Solid sphere centred at the origin.
     Sphere {
         /// Radius [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         radius: f64,
         #[command(flatten)]
         common: GenerateArgs,
@@ -127,10 +127,10 @@ pub enum MeshShape {
     /// Hemispherical shell (a bowl), opening upwards.
     Bowl {
         /// Outer radius [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         radius: f64,
         /// Wall thickness [m].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         thickness: f64,
         #[command(flatten)]
         common: GenerateArgs,
@@ -160,7 +160,7 @@ pub enum MeshShape {
 #[derive(Debug, Args)]
 pub struct GenerateArgs {
     /// Target element size [m] (default: a fifth of the smallest dimension).
-    #[arg(long, value_name = "H")]
+    #[arg(long, value_name = "H", allow_negative_numbers = true)]
     pub h: Option<f64>,
     /// Element order of the written mesh (2 puts curved mid-edge nodes on curved surfaces).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]

@@ -106,5 +106,10 @@ fn default_element_size(shape: &Shape) -> f64 {
         Shape::Sphere { radius } => 2.0 * radius,
         Shape::Bowl { thickness, .. } => 2.0 * thickness,
     };
-    smallest / 5.0
+    // Invalid dimensions get any valid size: the generator then names them.
+    if smallest.is_finite() && smallest > 0.0 {
+        smallest / 5.0
+    } else {
+        1.0
+    }
 }
