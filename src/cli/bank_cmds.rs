@@ -5,6 +5,7 @@ use modal_bank::{ModeBank, RetuneSpec};
 
 use super::args::{ExportArgs, InfoArgs, RetuneArgs};
 use super::bank_report::BankJson;
+use super::interrupt;
 use super::output::print_json;
 use super::write_atomic;
 
@@ -41,7 +42,8 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
     );
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
     let new = modal_bank::retune(&bank, RetuneSpec { material, scale: args.scale })?;
-    new.save(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    interrupt::guarded(|| new.save(&args.out))
+        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
     show(&new, args.json)?;
     if !args.json {
         println!("wrote {}", args.out.display());

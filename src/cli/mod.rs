@@ -5,6 +5,7 @@
 mod args;
 mod bank_cmds;
 mod bank_report;
+mod interrupt;
 mod material;
 mod mesh;
 mod output;
@@ -23,6 +24,7 @@ pub use args::{Cli, Command};
 /// Parses the command line, runs the command and maps the outcome to an exit code.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
+    interrupt::install();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
@@ -54,7 +56,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
     let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into));
+    let result =
+        interrupt::guarded(|| write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into)));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -8,6 +8,7 @@ use modal_precompute::{MeshSource, Request, Stage, SurfaceMeshing};
 
 use super::args::{ExportMatricesArgs, MaterialArgs, MeshInputArgs, PrecomputeArgs};
 use super::bank_report::BankJson;
+use super::interrupt;
 use super::output::{print_json, warn};
 use super::progress::Spinner;
 use super::{material, write_atomic};
@@ -56,7 +57,8 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     spinner.finish();
     let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;
     outcome.warnings.iter().for_each(|w| warn(w));
-    outcome.bank.save(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    interrupt::guarded(|| outcome.bank.save(&args.out))
+        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let report = BankJson::new(&outcome.bank, outcome.cached);
     if args.json {
         print_json(&report)

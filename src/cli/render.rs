@@ -11,6 +11,7 @@ use modal_scene::{BankProvider, BankRequest, ProviderError, Scene};
 use modal_synth::WavFormat;
 
 use super::args::RenderArgs;
+use super::interrupt;
 use super::output::{print_json, warn};
 use super::precompute::open_cache;
 use super::progress::Spinner;
@@ -121,15 +122,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
     warnings.iter().for_each(|w| warn(w));
     let rendered = rendered.context("render failed")?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
-    let wav = modal_scene::write_wav(&rendered, &out, format)?;
+    let wav = interrupt::guarded(|| modal_scene::write_wav(&rendered, &out, format))?;
     if wav.clipped > 0 {
         warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
     }
     if let Some(path) = &args.events {
-        modal_scene::write_events_json(&rendered.events, path)?;
+        interrupt::guarded(|| modal_scene::write_events_json(&rendered.events, path))?;
     }
     if let Some(path) = &args.spectrogram {
-        modal_scene::write_spectrogram_png(&rendered.channels, path)?;
+        interrupt::guarded(|| modal_scene::write_spectrogram_png(&rendered.channels, path))?;
     }
     let report = &rendered.report;
     if args.json {

@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use super::args::StrikeArgs;
 use super::bank_cmds::load_bank;
+use super::interrupt;
 use super::output::{print_json, warn};
 
 /// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
@@ -120,8 +121,10 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     let top_modes = top_modes(&bank, &strikes[0], &options)?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let gain = if args.normalize { WavGain::Normalize { peak: NORMALIZED_PEAK } } else { WavGain::default() };
-    let report = modal_synth::write_wav(&args.out, &[&rendered.samples], args.rate, format, gain)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    let report = interrupt::guarded(|| {
+        modal_synth::write_wav(&args.out, &[&rendered.samples], args.rate, format, gain)
+    })
+    .with_context(|| format!("cannot write {}", args.out.display()))?;
     if report.clipped > 0 {
         warn(&format!(
             "{} samples clipped at full scale (use --float, --normalize or a smaller --impulse)",

@@ -50,11 +50,12 @@ pub fn write_wav(rendered: &Rendered, path: &Path, format: WavFormat) -> Result<
 /// Writes the impact events as a JSON array.
 pub fn write_events_json(events: &[ImpactEvent], path: &Path) -> Result<(), SceneError> {
     let dir = parent_dir(path)?;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".modal-events-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| io_error(path, e))?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".modal-events-").suffix(".tmp");
+    // Like a plain `File::create` (0o666 minus the umask), not 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| io_error(path, e))?;
     serde_json::to_writer_pretty(&mut tmp, events).map_err(|e| io_error(path, e))?;
     tmp.write_all(b"\n").map_err(|e| io_error(path, e))?;
     tmp.persist(path).map_err(|e| io_error(path, e.error))?;
@@ -104,11 +105,12 @@ pub fn write_spectrogram_png(channels: &[Vec<f32>], path: &Path) -> Result<(), S
     let top = frames.iter().flatten().cloned().fold(f64::NEG_INFINITY, f64::max);
     let (width, height) = SPECTROGRAM_SIZE;
     let bins = SPECTROGRAM_WINDOW / 2 + 1;
-    let tmp = tempfile::Builder::new()
-        .prefix(".modal-spectrogram-")
-        .suffix(".png")
-        .tempfile_in(dir)
-        .map_err(|e| io_error(path, e))?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".modal-spectrogram-").suffix(".png");
+    // Like a plain `File::create` (0o666 minus the umask), not 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let tmp = builder.tempfile_in(dir).map_err(|e| io_error(path, e))?;
     {
         let root = BitMapBackend::new(tmp.path(), (width, height)).into_drawing_area();
         for x in 0..width {

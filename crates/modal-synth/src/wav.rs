@@ -109,11 +109,12 @@ pub fn write_wav(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".modal-wav-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| fail(&e))?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".modal-wav-").suffix(".tmp");
+    // Like a plain `File::create` (0o666 minus the umask), not 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| fail(&e))?;
     let spec = hound::WavSpec {
         channels: channels.len() as u16,
         sample_rate,
