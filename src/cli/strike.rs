@@ -35,7 +35,9 @@ struct StrikeJson {
     clipped_samples: usize,
     modes_total: usize,
     modes_skipped: usize,
+    modes_culled: u64,
     mode_samples: u64,
+    samples_computed: u64,
 }
 
 #[derive(Serialize)]
@@ -146,7 +148,9 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         clipped_samples: report.clipped,
         modes_total: rendered.stats.modes_total,
         modes_skipped: rendered.stats.modes_skipped,
+        modes_culled: rendered.stats.modes_culled,
         mode_samples: rendered.stats.mode_samples,
+        samples_computed: rendered.stats.samples_rendered,
     };
     if args.json {
         return print_json(&json);
@@ -201,5 +205,9 @@ fn print_human(json: &StrikeJson) {
     println!(
         "wrote {} ({:.3} s at {} Hz, peak {:.3} of full scale, {} of {} modes skipped as inaudible)",
         json.out, json.duration_s, json.sample_rate, json.peak, json.modes_skipped, json.modes_total
+    );
+    println!(
+        "work: {} mode-samples over {} computed samples; {} modes culled once below the threshold",
+        json.mode_samples, json.samples_computed, json.modes_culled
     );
 }
