@@ -56,10 +56,11 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
     let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    let result =
-        interrupt::guarded(|| write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into)));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    interrupt::guarded(|| {
+        let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into));
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result
+    })
 }
