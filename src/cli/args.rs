@@ -33,6 +33,9 @@ pub enum Command {
     Strike(StrikeArgs),
     /// Simulate a rigid-body scene and render its sound (no scene: the built-in demo).
     Render(RenderArgs),
+    /// Reproduce the measurements in BENCHMARKS.md (eigen vs scipy, accuracy vs time, synthesis).
+    #[command(subcommand)]
+    Bench(crate::cli::bench::BenchCommand),
 }
 
 /// Material selection shared by every command that builds matrices.

@@ -5,6 +5,7 @@
 mod args;
 mod bank_cmds;
 mod bank_report;
+mod bench;
 mod interrupt;
 mod material;
 mod mesh;
@@ -46,6 +47,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Mesh(args)) => mesh::run(args.shape),
         Some(Command::Strike(args)) => strike::run(args),
         Some(Command::Render(args)) => render::run(args),
+        Some(Command::Bench(command)) => bench::run(command),
     }
 }
 
