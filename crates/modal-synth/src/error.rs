@@ -12,6 +12,19 @@ pub enum SynthError {
     /// An impulse vector with a NaN or infinite component.
     #[error("impulse [{}, {}, {}] N·s is not finite", .0[0], .0[1], .0[2])]
     InvalidImpulse([f64; 3]),
+    /// An impulse whose response could exceed the f32 output range.
+    #[error(
+        "impulse [{}, {}, {}] N·s would drive the output up to {bound:e} (limit {limit:e} output units, f32 range)",
+        impulse[0], impulse[1], impulse[2]
+    )]
+    OutputOverflow {
+        /// The offending impulse [N·s].
+        impulse: [f64; 3],
+        /// Bound on |output| with this impulse added (sum of mode amplitudes of all impulses so far).
+        bound: f64,
+        /// Largest accepted bound.
+        limit: f64,
+    },
     /// A contact time that is NaN, negative or longer than the allowed maximum.
     #[error("contact time {0} s must be finite and within 0..={max} s", max = crate::contact::MAX_CONTACT_TIME_S)]
     InvalidContactTime(f64),

@@ -11,8 +11,11 @@
 //! duration, excited phase-exactly at fractional sample times with the exact
 //! half-sine contact spectrum ([`contact`]), and dropped once inaudible.
 //! [`ModalVoice`] is the streaming engine the scene mixes; [`render_strikes`]
-//! and [`write_wav`] serve the `modal strike` command. The math, units and
-//! conventions are in `docs/synthesis.md`.
+//! and [`write_wav`] serve the `modal strike` command. [`reference`] is the
+//! f64 closed form every path is measured against, [`study`] the
+//! error-versus-cost measurement of `modal bench synth`, and [`synthetic`]
+//! builds seeded synthetic banks for both. The math, units and conventions
+//! are in `docs/synthesis.md`.
 
 mod complex;
 pub mod contact;
@@ -21,7 +24,10 @@ pub mod kernel;
 mod model;
 mod offline;
 mod options;
+pub mod reference;
+pub mod study;
 pub mod surface;
+pub mod synthetic;
 mod voice;
 mod wav;
 
@@ -36,12 +42,13 @@ pub use offline::{
     MIN_AUTO_DURATION_S,
 };
 pub use options::{
-    check_sample_rate, Kernel, OutputGain, OutputQuantity, SynthOptions, MAX_FREQUENCY_FRACTION,
-    MAX_SAMPLE_RATE, MIN_FREQUENCY_HZ, MIN_SAMPLE_RATE,
+    check_sample_rate, classify_mode, Kernel, OutputGain, OutputQuantity, SkipReason, SynthOptions,
+    MAX_FREQUENCY_FRACTION, MAX_SAMPLE_RATE, MIN_FREQUENCY_HZ, MIN_SAMPLE_RATE,
 };
+pub use reference::{ClosedForm, SignalError};
 pub use surface::SurfacePoint;
 pub use voice::{
-    ExcitedMode, ImpactPoint, ModalVoice, VoiceStats, ABSOLUTE_FLOOR, BLOCK, PARALLEL_MIN_MODES,
+    ExcitedMode, ImpactPoint, ModalVoice, VoiceStats, ABSOLUTE_FLOOR, BLOCK, MAX_OUTPUT, PARALLEL_MIN_MODES,
     REANCHOR_BLOCKS,
 };
 pub use wav::{write_wav, WavFormat, WavGain, WavReport, DEFAULT_WAV_GAIN};

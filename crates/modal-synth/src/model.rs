@@ -48,6 +48,13 @@ impl SynthModel {
                 bank.shapes.len()
             ));
         }
+        if let Some(k) = bank.shapes.iter().position(|x| !x.is_finite()) {
+            let (mode, node) = (k / 3 / nodes.max(1), k / 3 % nodes.max(1));
+            return bad(format!("mode {mode} has a non-finite shape value at surface node {node}"));
+        }
+        if let Some(k) = bank.surface.positions.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+            return bad(format!("surface node {k} has a non-finite position"));
+        }
         if let Some(t) = bank.surface.triangles.iter().position(|t| t.iter().any(|&k| k >= nodes)) {
             return bad(format!("surface triangle {t} refers to a node >= {nodes}"));
         }

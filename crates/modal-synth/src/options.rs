@@ -1,5 +1,6 @@
 //! Options of a voice: sample rate, culling, output gain model, kernel.
 
+use crate::complex::C64;
 use crate::error::SynthError;
 
 /// Lowest accepted sample rate \[Hz\].
@@ -11,6 +12,52 @@ pub const MIN_FREQUENCY_HZ: f64 = 20.0;
 /// Modes whose damped frequency is at or above this fraction of the sample
 /// rate are not synthesized (no aliasing).
 pub const MAX_FREQUENCY_FRACTION: f64 = 0.45;
+
+/// Why a bank mode is not synthesized (see [`classify_mode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkipReason {
+    /// Frequency, decay rate or damping ratio is NaN or infinite, or the
+    /// decay rate is negative (a growing mode).
+    NonFinite,
+    /// Damping ratio ξ ≥ 1: no oscillation.
+    Overdamped,
+    /// Damped frequency below [`MIN_FREQUENCY_HZ`] (inaudible, incl. rigid modes at 0 Hz).
+    BelowMinFrequency,
+    /// Damped frequency at or above [`MAX_FREQUENCY_FRACTION`] × the sample
+    /// rate: would alias (this includes every mode at or above Nyquist).
+    AboveBand,
+}
+
+impl std::fmt::Display for SkipReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SkipReason::NonFinite => "non-finite or negative damping data",
+            SkipReason::Overdamped => "overdamped (damping ratio >= 1)",
+            SkipReason::BelowMinFrequency => "damped frequency below 20 Hz",
+            SkipReason::AboveBand => "damped frequency at or above 0.45 x sample rate",
+        })
+    }
+}
+
+/// Complex frequency `s = −d + iω_d` [1/s] of a mode with undamped frequency
+/// `f_hz`, decay rate `d` [1/s] and damping ratio `xi` at sample rate
+/// `fs_hz`, with `ω_d = 2π f √(1 − ξ²)`; or why the mode is not synthesized.
+pub fn classify_mode(f_hz: f64, d: f64, xi: f64, fs_hz: f64) -> Result<C64, SkipReason> {
+    if !(f_hz.is_finite() && d.is_finite() && xi.is_finite()) || d < 0.0 {
+        return Err(SkipReason::NonFinite);
+    }
+    if xi >= 1.0 {
+        return Err(SkipReason::Overdamped);
+    }
+    let fd = f_hz * (1.0 - xi * xi).max(0.0).sqrt();
+    if fd < MIN_FREQUENCY_HZ {
+        return Err(SkipReason::BelowMinFrequency);
+    }
+    if fd >= MAX_FREQUENCY_FRACTION * fs_hz {
+        return Err(SkipReason::AboveBand);
+    }
+    Ok(C64::new(-d, 2.0 * std::f64::consts::PI * fd))
+}
 
 /// What the output measures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

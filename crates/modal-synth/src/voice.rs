@@ -37,9 +37,7 @@ use crate::contact::{half_sine_spectrum, MAX_CONTACT_TIME_S};
 use crate::error::SynthError;
 use crate::kernel::{self, LaneBuf, SimdPath, CHUNK, LANES, TILE};
 use crate::model::SynthModel;
-use crate::options::{
-    Kernel, OutputGain, OutputQuantity, SynthOptions, MAX_FREQUENCY_FRACTION, MIN_FREQUENCY_HZ,
-};
+use crate::options::{classify_mode, Kernel, OutputGain, OutputQuantity, SkipReason, SynthOptions};
 use crate::surface::SurfacePoint;
 use modal_bank::ModeBank;
 use rayon::prelude::*;
@@ -55,6 +53,12 @@ pub const REANCHOR_BLOCKS: u64 = 16;
 pub const ABSOLUTE_FLOOR: f64 = 1e-30;
 /// Active modes from which chunks are rendered in parallel.
 pub const PARALLEL_MIN_MODES: usize = 2 * CHUNK;
+/// Largest accepted bound on the output magnitude (output units): the sum
+/// over all impulses of a voice of their per-mode initial amplitudes. Far
+/// inside the f32 range (3.4e38), so the f32 kernel and its partial sums
+/// can never overflow; an impulse that would exceed it is refused with
+/// [`SynthError::OutputOverflow`] instead of rendering `inf`/NaN.
+pub const MAX_OUTPUT: f64 = 1e30;
 /// Largest accepted event time \[s\] (about 31 years).
 pub const MAX_TIME_S: f64 = 1e9;
 
@@ -96,6 +100,9 @@ pub struct VoiceStats {
     /// Modes never synthesized: overdamped, damped frequency < 20 Hz or
     /// ≥ 0.45·fs, or non-finite data.
     pub modes_skipped: usize,
+    /// Of the skipped modes, those at or above 0.45·fs (incl. Nyquist and
+    /// beyond): dropped so that nothing aliases.
+    pub modes_above_band: usize,
     /// Modes active right now.
     pub modes_active: usize,
     /// Times a mode left the active set (culling or budget).
@@ -199,6 +206,10 @@ pub struct ModalVoice {
     events: Vec<Event>,
     seq: u64,
     stats: VoiceStats,
+    /// Why each bank mode is not synthesized (`None`: synthesized).
+    skip: Vec<Option<SkipReason>>,
+    /// Sum over scheduled impulses of `Σ_i |u_i|`: a bound on `|y|`.
+    output_bound: f64,
     /// Scratch full-size state, zero between operations.
     cur: Vec<C64>,
     /// Scratch candidate and kept index lists.
@@ -230,28 +241,21 @@ impl ModalVoice {
             anchor: vec![C64::ZERO; n],
             grid: vec![C64::ZERO; n],
         };
-        let mut skipped = 0;
-        for i in 0..n {
-            let (f, d, xi) = (model.frequencies_hz[i], model.decay_rates[i], model.damping_ratios[i]);
-            let fd = f * (1.0 - xi * xi).max(0.0).sqrt();
-            let ok = f.is_finite()
-                && d.is_finite()
-                && d >= 0.0
-                && xi.is_finite()
-                && xi < 1.0
-                && fd >= MIN_FREQUENCY_HZ
-                && fd < MAX_FREQUENCY_FRACTION * fs;
-            if !ok {
-                skipped += 1;
-                continue;
-            }
-            let s = C64::new(-d, 2.0 * PI * fd);
-            modes.enabled[i] = true;
-            modes.s[i] = s;
-            modes.pole[i] = s.scale(1.0 / fs).exp();
-            modes.pole_block[i] = s.scale(BLOCK as f64 / fs).exp();
-            modes.block_decay2[i] = modes.pole_block[i].norm2();
-        }
+        let skip: Vec<Option<SkipReason>> = (0..n)
+            .map(|i| {
+                let (f, d, xi) = (model.frequencies_hz[i], model.decay_rates[i], model.damping_ratios[i]);
+                let s = match classify_mode(f, d, xi, fs) {
+                    Ok(s) => s,
+                    Err(reason) => return Some(reason),
+                };
+                modes.enabled[i] = true;
+                modes.s[i] = s;
+                modes.pole[i] = s.scale(1.0 / fs).exp();
+                modes.pole_block[i] = s.scale(BLOCK as f64 / fs).exp();
+                modes.block_decay2[i] = modes.pole_block[i].norm2();
+                None
+            })
+            .collect();
         let path = match opts.kernel {
             Kernel::Auto => Some(SimdPath::detect()),
             Kernel::Portable => Some(SimdPath::Portable),
@@ -271,7 +275,14 @@ impl ModalVoice {
             synced: None,
             events: Vec::new(),
             seq: 0,
-            stats: VoiceStats { modes_total: n, modes_skipped: skipped, ..VoiceStats::default() },
+            stats: VoiceStats {
+                modes_total: n,
+                modes_skipped: skip.iter().filter(|r| r.is_some()).count(),
+                modes_above_band: skip.iter().filter(|r| **r == Some(SkipReason::AboveBand)).count(),
+                ..VoiceStats::default()
+            },
+            skip,
+            output_bound: 0.0,
             cur: vec![C64::ZERO; n],
             cand: Vec::new(),
             keep: Vec::new(),
@@ -338,6 +349,12 @@ impl ModalVoice {
         self.active.idx.is_empty() && self.events.is_empty()
     }
 
+    /// Why bank mode `mode` is not synthesized, or `None` when it is (or
+    /// when `mode` is out of range).
+    pub fn skip_reason(&self, mode: usize) -> Option<SkipReason> {
+        self.skip.get(mode).copied().flatten()
+    }
+
     /// Which f32 path renders (`None` for the f64 reference kernel).
     pub fn simd_path(&self) -> Option<SimdPath> {
         self.path
@@ -379,6 +396,12 @@ impl ModalVoice {
             return Err(SynthError::InvalidContactTime(contact_time_s));
         }
         let point = self.locate(at.into())?;
+        let bound = self.output_bound
+            + self.excitation(&point, impulse_ns, contact_time_s).iter().map(|m| m.amplitude).sum::<f64>();
+        if bound.is_nan() || bound > MAX_OUTPUT {
+            return Err(SynthError::OutputOverflow { impulse: impulse_ns, bound, limit: MAX_OUTPUT });
+        }
+        self.output_bound = bound;
         if !self.gains_set {
             self.set_mic(&point);
         }
