@@ -98,6 +98,28 @@ pub enum MeshError {
         /// The earlier element with the same corners.
         first: usize,
     },
+    /// Two tets sharing a face lie on the same side of it: the mesh is folded
+    /// (an inverted element inside a good mesh, not a vertex-order convention).
+    #[error(
+        "elements {first} and {element} overlap: they lie on the same side of their shared face \
+         (a folded or tangled mesh; untangle or remesh it)"
+    )]
+    FoldedTets {
+        /// The later element.
+        element: usize,
+        /// The earlier element sharing the face.
+        first: usize,
+    },
+    /// Three or more tets share one face.
+    #[error("elements {first}, {second} and {element} share one face: overlapping elements")]
+    OverlappingTets {
+        /// The third element found on the face.
+        element: usize,
+        /// The first element on the face.
+        first: usize,
+        /// The second element on the face.
+        second: usize,
+    },
     /// A tet has (nearly) zero volume.
     #[error(
         "element {element} is degenerate: volume {volume:e} m^3 is below {tolerance:e} m^3 \

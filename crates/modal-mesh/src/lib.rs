@@ -25,6 +25,7 @@
 
 mod error;
 mod measure;
+mod overlap;
 mod promote;
 mod quality;
 mod surface;

@@ -12,15 +12,18 @@
 //!    (a regular tet has `V/ℓ³ ≈ 0.118`; the threshold is far below any
 //!    usable element and far above round-off, and does not depend on the
 //!    mesh's overall size or units) → error;
-//! 5. 10-node tets: the Jacobian determinant of the quadratic geometry map
+//! 5. overlaps: two tets sharing a face must lie on opposite sides of it
+//!    (a folded mesh is an error, not something to reorient; see
+//!    [`crate::overlap`]); three tets on one face are an error too;
+//! 6. 10-node tets: the Jacobian determinant of the quadratic geometry map
 //!    must be positive at 15 reference points (the 4 vertices, the 6 edge
 //!    midpoints, the 4 points of the degree-2 Keast rule and the centroid);
 //!    det J is a cubic polynomial, so this is a sampled check, the standard
 //!    one in FE codes → error naming the element and the point;
-//! 6. unused nodes are dropped (indices renumbered, order kept) and counted;
-//! 7. connected parts (through shared nodes) are counted: each part has its
+//! 7. unused nodes are dropped (indices renumbered, order kept) and counted;
+//! 8. connected parts (through shared nodes) are counted: each part has its
 //!    own six rigid-body modes;
-//! 8. quality: the smallest dihedral angle is reported and tets with one
+//! 9. quality: the smallest dihedral angle is reported and tets with one
 //!    below 5° are counted as slivers (a warning only).
 
 use std::collections::HashMap;
@@ -88,6 +91,7 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
     check_duplicates(&mesh)?;
     let reoriented = orient(&mut mesh);
     let (volume, min_v, max_v) = check_volumes(&mesh)?;
+    crate::overlap::check_overlaps(&mesh)?;
     if let Cells::Tet10(tets) = &mesh.cells {
         for (e, t) in tets.iter().enumerate() {
             check_tet10_jacobian(&mesh.nodes, e, t)?;

@@ -175,3 +175,63 @@ fn quadratic_surface_carries_mid_edge_nodes() {
     assert!((flux_of_position(&s) - 3.0).abs() < 1e-12);
     assert!((s.area() - 6.0).abs() < 1e-12);
 }
+
+/// Two unit tets on the face (1, 2, 3): apex 0 at the origin, the second apex
+/// at `apex`. Opposite sides is a valid mesh; the same side is a fold.
+fn two_tets(apex: [f64; 3]) -> TetMesh {
+    TetMesh {
+        nodes: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], apex],
+        cells: Cells::Tet4(vec![[0, 1, 2, 3], [4, 1, 3, 2]]),
+        groups: Vec::new(),
+    }
+}
+
+#[test]
+fn tets_on_opposite_sides_of_a_shared_face_pass() {
+    let (_, report) = check(two_tets([1.0, 1.0, 1.0])).unwrap();
+    assert_eq!(report.reoriented, 0);
+    assert!((report.volume - (1.0 / 6.0 + 1.0 / 3.0)).abs() < 1e-12, "{}", report.volume);
+}
+
+#[test]
+fn folded_tets_are_an_error_not_silently_reoriented() {
+    // The second apex lies on the first tet's side: element 1 is inverted
+    // inside the mesh. Reorienting it would double-count the overlap.
+    let err = check(two_tets([0.1, 0.1, 0.1])).unwrap_err();
+    assert_eq!(err, MeshError::FoldedTets { element: 1, first: 0 });
+    assert!(err.to_string().contains("elements 0 and 1 overlap"), "{err}");
+}
+
+#[test]
+fn an_interior_node_pushed_through_a_face_folds_a_box_mesh() {
+    // A 2×2×2-cell box has one interior node (the centre); moving it past
+    // the boundary folds the tets around it.
+    let mut mesh = box_mesh([1.0, 1.0, 1.0], [2, 2, 2]);
+    let centre = mesh.nodes.iter().position(|p| p.iter().all(|c| (c - 0.5).abs() < 1e-12)).unwrap();
+    let (_, ok) = check(mesh.clone()).unwrap();
+    assert_eq!(ok.reoriented, 0);
+    mesh.nodes[centre] = [0.5, 0.5, 1.4];
+    let err = check(mesh).unwrap_err();
+    assert!(matches!(err, MeshError::FoldedTets { .. }), "{err}");
+}
+
+#[test]
+fn a_whole_mesh_in_the_other_vertex_order_is_reoriented_not_rejected() {
+    let mut mesh = box_mesh([1.0, 2.0, 3.0], [3, 2, 2]);
+    if let Cells::Tet4(t) = &mut mesh.cells {
+        t.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    let (_, report) = check(mesh).unwrap();
+    assert_eq!(report.reoriented, report.tets);
+}
+
+#[test]
+fn three_tets_on_one_face_are_an_error() {
+    let mut mesh = two_tets([1.0, 1.0, 1.0]);
+    mesh.nodes.push([2.0, 2.0, 2.0]);
+    if let Cells::Tet4(t) = &mut mesh.cells {
+        t.push([5, 1, 3, 2]);
+    }
+    let err = check(mesh).unwrap_err();
+    assert!(matches!(err, MeshError::OverlappingTets { element: 2, first: 0, second: 1 }), "{err}");
+}
