@@ -18,7 +18,7 @@ mod pipeline;
 
 pub use key::cache_key;
 pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, SurfaceMeshing};
-pub use pipeline::{assemble_matrices, precompute, Assembled, Outcome, Request, Stage};
+pub use pipeline::{assemble_matrices, precompute, Assembled, Outcome, Request, Stage, TARGET_RESIDUAL};
 
 /// Version of the numerical pipeline; part of every cache key, so changing
 /// anything that alters results must bump it.
