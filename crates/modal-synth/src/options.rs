@@ -43,7 +43,15 @@ impl std::fmt::Display for SkipReason {
 /// `f_hz`, decay rate `d` [1/s] and damping ratio `xi` at sample rate
 /// `fs_hz`, with `ω_d = 2π f √(1 − ξ²)`; or why the mode is not synthesized.
 pub fn classify_mode(f_hz: f64, d: f64, xi: f64, fs_hz: f64) -> Result<C64, SkipReason> {
-    if !(f_hz.is_finite() && d.is_finite() && xi.is_finite()) || d < 0.0 {
+    if !(f_hz.is_finite() && d.is_finite()) || d < 0.0 {
+        return Err(SkipReason::NonFinite);
+    }
+    // f_d ≤ f: rigid (0 Hz) modes are "below 20 Hz" whatever their (then
+    // undefined) damping ratio.
+    if f_hz < MIN_FREQUENCY_HZ {
+        return Err(SkipReason::BelowMinFrequency);
+    }
+    if !xi.is_finite() {
         return Err(SkipReason::NonFinite);
     }
     if xi >= 1.0 {
