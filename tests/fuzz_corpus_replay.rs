@@ -9,12 +9,12 @@ use std::path::Path;
 /// The parser behind a fuzz target (same calls as `fuzz/fuzz_targets/*.rs`).
 fn run_target(target: &str, data: &[u8]) {
     match target {
-        "msh" => drop(modal_mesh::io::read_msh(data, 1.0)),
-        "medit" => drop(modal_mesh::io::read_medit(data, 1.0)),
+        "msh" => check_mesh(modal_mesh::io::read_msh(data, 1.0)),
+        "medit" => check_mesh(modal_mesh::io::read_medit(data, 1.0)),
         "tetgen" => {
             let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
             let (node, ele) = data.split_at(split);
-            drop(modal_mesh::io::read_tetgen(node, ele.get(1..).unwrap_or(&[]), 1.0));
+            check_mesh(modal_mesh::io::read_tetgen(node, ele.get(1..).unwrap_or(&[]), 1.0));
         }
         "obj" => drop(modal_tetra::parse_surface(data, modal_tetra::SurfaceFormat::Obj, 1.0, None)),
         "stl" => drop(modal_tetra::parse_surface(data, modal_tetra::SurfaceFormat::Stl, 1.0, None)),
@@ -26,6 +26,13 @@ fn run_target(target: &str, data: &[u8]) {
             }
         }
         other => panic!("corpus folder '{other}' has no target"),
+    }
+}
+
+/// A parsed mesh also goes through the checks, as in the fuzz targets.
+fn check_mesh(parsed: Result<modal_mesh::TetMesh, modal_mesh::MeshError>) {
+    if let Ok(mesh) = parsed {
+        drop(modal_mesh::check(mesh));
     }
 }
 

@@ -5,5 +5,7 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let (node, ele) = data.split_at(split);
-    let _ = modal_mesh::io::read_tetgen(node, ele.get(1..).unwrap_or(&[]), 1.0);
+    if let Ok(mesh) = modal_mesh::io::read_tetgen(node, ele.get(1..).unwrap_or(&[]), 1.0) {
+        let _ = modal_mesh::check(mesh);
+    }
 });
