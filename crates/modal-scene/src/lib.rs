@@ -9,8 +9,10 @@
 //! stereo) heard at a listener with 1/r attenuation and r/c delay, a
 //! [`RenderReport`], optional impact events (JSON) and a spectrogram (PNG).
 
+mod collider;
 mod error;
 mod excite;
+mod ground;
 mod listener;
 mod material;
 mod output;
@@ -21,11 +23,13 @@ mod spec;
 pub mod stand_in;
 mod validate;
 
+pub use collider::{DECOMPOSITION_CONCAVITY, DECOMPOSITION_RESOLUTION};
 pub use error::SceneError;
 pub use excite::{
     hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_APPROACH_CONTINUING_M_S,
     MIN_APPROACH_M_S, MIN_CONTACT_TIME_S, MIN_IMPULSE_NS, RECONTACT_WINDOW_S, SUSTAIN_DEADBAND,
 };
+pub use ground::GROUND_NAME;
 pub use listener::{MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
 pub use material::{preset_names, resolve_material};
 pub use modal_synth::WavFormat;
@@ -39,7 +43,8 @@ pub use render::{
     FULL_SCALE_PA, SILENCE_DB,
 };
 pub use spec::{
-    BodyKind, Channels, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec, MaterialSpec, MeshSource,
-    ObjectSpec, RotationSpec, Scene, DEMO_TOML, GENERATORS,
+    BodyKind, Channels, ColliderKind, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec,
+    MaterialSpec, MeshSource, ObjectSpec, RotationSpec, Scene, AUTO_DECOMPOSITION_RATIO,
+    DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
 };
 pub use validate::{MAX_DURATION_S, MAX_OBJECTS};

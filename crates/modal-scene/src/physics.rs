@@ -2,11 +2,29 @@
 //!
 //! Bodies: a dynamic object gets the **mass, centre of mass and inertia of
 //! its bank** (the tet mesh's exact integrals) as explicit mass properties;
-//! its collider is the convex hull of the bank's surface nodes with zero
-//! density, so the collider shape never changes the dynamics. A fixed object
-//! uses a triangle mesh of its surface. The body frame is the mesh frame, so
+//! its collider ([`crate::collider`]: the convex hull of the bank's surface
+//! nodes, or a convex decomposition) has zero density, so the collider shape
+//! never changes the dynamics. A fixed object uses a triangle mesh of its
+//! surface. The body frame is the mesh frame, so
 //! contact points in collider coordinates are directly points of the bank's
 //! surface. The ground is a half-space `y ≥ height` pointing up.
+//!
+//! **Rolling resistance.** A rigid hull rolling or rocking on a rigid floor
+//! loses no energy in rapier, so a bowl would rock on its faceted hull for
+//! ever and never sleep. Real contacts dissipate through the deformation of
+//! the contact patch, modelled (as in textbook rolling resistance) by a
+//! couple `b·N` opposing the rotation, with `N` the normal contact force and
+//! `b` a lever arm of the order of the patch half-width (per object,
+//! `rolling_resistance`, default 1 mm). Per step each awake dynamic body
+//! receives the angular impulse `−ω̂ · min(b·J_n, |ω| / (ω̂ᵀ I⁻¹ ω̂))`, where
+//! `J_n` is the step's total normal contact impulse on it, capped at
+//! [`ROLLING_LOAD_CAP`] `· m·|g|·dt` (the couple models the resting load, not
+//! impacts): the clamp stops the rotation instead of reversing it. Free flight is unaffected (no
+//! contact, no couple). Bodies then come to rest and fall asleep under
+//! rapier's sleep rule (every point slower than 0.1 m/s), after
+//! [`SLEEP_AFTER_S`] instead of rapier's 0.5 s: a bouncing or rocking body
+//! passes below the threshold only for a few milliseconds at its turning
+//! points, and a sleeping body is woken by anything that touches it.
 //!
 //! Stepping is single-threaded with a fixed `dt = 1/physics_rate` and the
 //! Coulomb friction model (one friction constraint per contact point), so the
@@ -18,9 +36,20 @@ use modal_bank::ModeBank;
 use modal_fem::Material;
 use rapier3d::prelude::*;
 
+use crate::collider::{surface_points, surface_triangles, ShapeCache};
 use crate::material::{plane_strain_modulus, resolve_material};
 use crate::spec::{BodyKind, Scene};
 use crate::SceneError;
+
+/// A dynamic body whose every point moves slower than rapier's threshold
+/// (0.1 m/s) for this long falls asleep [s] (rapier's default is 0.5 s).
+pub const SLEEP_AFTER_S: f64 = 0.2;
+
+/// The normal impulse entering the rolling-resistance couple is capped at
+/// this many times the body's weight impulse `m·|g|·dt`: the couple models
+/// the resting or rolling load, not the brief impulses of impacts (their
+/// losses are the restitution's business).
+pub const ROLLING_LOAD_CAP: f64 = 2.0;
 
 /// `user_data` of the ground collider.
 const GROUND: u128 = u128::MAX;
@@ -76,6 +105,10 @@ pub(crate) struct World {
     pub sides: Vec<ContactSide>,
     /// Pre-step velocity state of each object: (linvel, angvel, world com).
     pre_step: Vec<([f64; 3], [f64; 3], [f64; 3])>,
+    /// Per object: rolling-resistance lever arm [m].
+    rolling_m: Vec<f64>,
+    /// Per object: scratch, normal impulse of the last step [N·s].
+    normal_ns: Vec<f64>,
     gravity: [f64; 3],
 }
 
@@ -165,8 +198,9 @@ impl World {
         world.integration_parameters.friction_model = FrictionModel::Coulomb;
         let mut bodies = Vec::with_capacity(banks.len());
         let mut sides = Vec::with_capacity(banks.len() + 1);
+        let mut shapes = ShapeCache::default();
         for (i, bank) in banks.iter().enumerate() {
-            let (handle, side) = add_object(&mut world, scene, i, bank)?;
+            let (handle, side) = add_object(&mut world, &mut shapes, scene, i, bank)?;
             bodies.push(handle);
             sides.push(side);
         }
@@ -189,7 +223,9 @@ impl World {
             });
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
-        Ok(World { world, bodies, sides, pre_step, gravity: scene.gravity_m_s2 })
+        let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
+        let normal_ns = vec![0.0; bodies.len()];
+        Ok(World { world, bodies, sides, pre_step, rolling_m, normal_ns, gravity: scene.gravity_m_s2 })
     }
 
     /// World position of object `i`'s centre of mass [m].
@@ -261,6 +297,43 @@ impl World {
         }
     }
 
+    /// Applies the rolling-resistance couple (module doc) for the contacts
+    /// `pairs` of the last step.
+    pub fn resist_rolling(&mut self, pairs: &[PairContacts]) {
+        self.normal_ns.iter_mut().for_each(|x| *x = 0.0);
+        for pair in pairs {
+            let jn: f64 = pair.points.iter().map(|p| p.normal_impulse).sum();
+            for side in pair.sides {
+                if let Some(i) = self.sides[side].object {
+                    self.normal_ns[i] += jn;
+                }
+            }
+        }
+        let dt = self.world.integration_parameters.dt as f64;
+        let g = dot(self.gravity, self.gravity).sqrt();
+        for (i, h) in self.bodies.iter().enumerate() {
+            let load = ROLLING_LOAD_CAP * self.sides[i].mass_kg * g * dt;
+            let (jn, b) = (self.normal_ns[i].min(load), self.rolling_m[i]);
+            let body = &mut self.world.bodies[*h];
+            if jn <= 0.0 || b <= 0.0 || !body.is_dynamic() || body.is_sleeping() {
+                continue;
+            }
+            let w = d3(body.angvel());
+            let speed = dot(w, w).sqrt();
+            if !(speed > 0.0 && speed.is_finite()) {
+                continue;
+            }
+            let axis = w.map(|x| x / speed);
+            let inv = body.mass_properties().effective_world_inv_inertia * v3(axis);
+            let k = dot(axis, d3(inv));
+            if !(k > 0.0 && k.is_finite()) {
+                continue;
+            }
+            let couple = (b * jn).min(speed / k);
+            body.apply_torque_impulse(v3(axis.map(|x| -couple * x)), false);
+        }
+    }
+
     fn side_of(&self, user_data: u128) -> usize {
         if user_data == GROUND {
             self.sides.len() - 1
@@ -310,9 +383,10 @@ fn friction_world(data: &ContactData, n: [f64; 3]) -> [f64; 3] {
 
 fn add_object(
     world: &mut PhysicsWorld,
+    shapes: &mut ShapeCache,
     scene: &Scene,
     i: usize,
-    bank: &ModeBank,
+    bank: &Arc<ModeBank>,
 ) -> Result<(RigidBodyHandle, ContactSide), SceneError> {
     let o = &scene.objects[i];
     let path = format!("objects[{i}]");
@@ -322,7 +396,6 @@ fn add_object(
     let origin = [o.position_m[0] - rc[0], o.position_m[1] - rc[1], o.position_m[2] - rc[2]];
     let rotation = Rotation::from_xyzw(q[1] as f32, q[2] as f32, q[3] as f32, q[0] as f32).normalize();
     let pose = Pose::from_parts(v3(origin), rotation);
-    let points: Vec<Vector> = bank.surface.positions.iter().map(|p| v3(*p)).collect();
     let material = &bank.material;
     let dynamic = o.body == BodyKind::Dynamic;
     let builder = if dynamic {
@@ -339,13 +412,9 @@ fn add_object(
         RigidBodyBuilder::fixed().pose(pose)
     };
     let collider = if dynamic {
-        ColliderBuilder::convex_hull(&points).ok_or_else(|| SceneError::Collider {
-            path: path.clone(),
-            message: "degenerate convex hull".into(),
-        })?
+        ColliderBuilder::new(shapes.dynamic_shape(bank, o.collider, &path)?)
     } else {
-        let tris: Vec<[u32; 3]> = bank.surface.triangles.iter().map(|t| t.map(|k| k as u32)).collect();
-        ColliderBuilder::trimesh(points, tris)
+        ColliderBuilder::trimesh(surface_points(bank), surface_triangles(bank))
             .map_err(|e| SceneError::Collider { path: path.clone(), message: format!("{e:?}") })?
     };
     let collider = collider
@@ -356,6 +425,7 @@ fn add_object(
         .restitution_combine_rule(CoefficientCombineRule::Average)
         .user_data(i as u128);
     let handle = world.bodies.insert(builder);
+    world.bodies[handle].activation_mut().time_until_sleep = SLEEP_AFTER_S as f32;
     world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
     let side = ContactSide {
         object: Some(i),

@@ -7,9 +7,14 @@
 //!    the listener; once every body sleeps the remaining steps are skipped;
 //! 3. **synthesis**: one [`modal_synth::ModalVoice`] per object that was
 //!    struck (objects never hit cost nothing), in parallel over objects, each
-//!    rendered from its first strike until it has decayed below
-//!    [`SILENCE_DB`] of its own peak with no strike pending;
-//! 4. **mix**: per object and ear, 1/r gain and r/c delay ([`crate::listener`]).
+//!    rendered from its first strike until, with no strike pending, a block
+//!    of it as heard from the object's nearest point to an ear is
+//!    [`SILENCE_DB`] below the output's estimated peak (the largest object
+//!    peak heard from its farthest point); that last block fades out so the
+//!    cut is click-free. The estimate needs every voice's peak, so voices are
+//!    rendered in two parallel phases: up to their last strike, then the tail;
+//! 4. **mix**: per object and ear, 1/r gain and r/c delay ([`crate::listener`]),
+//!    the ears in parallel.
 //!
 //! **Level.** Mode `i` radiates like a pulsating sphere of radius
 //! `a = √(A/4π)` (the sphere with the object's surface area `A`) whose
@@ -35,6 +40,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::excite::{Exciter, ImpactEvent, StepInput, StepStrikes, Strike};
+use crate::ground::with_slab;
 use crate::listener::{add_heard, Trajectory};
 use crate::physics::{check_ground_clearance, PairContacts, World};
 use crate::provider::resolve_banks;
@@ -47,8 +53,9 @@ pub const AIR_IMPEDANCE_PA_S_M: f64 = 413.0;
 pub const FULL_SCALE_PA: f64 = 20.0;
 /// Length of the raised-cosine fade at the end of the output [s].
 pub const FADE_OUT_S: f64 = 0.005;
-/// A voice stops once a block is this far below the object's peak [dB].
-pub const SILENCE_DB: f64 = -140.0;
+/// A voice stops once a block of it, heard from its nearest point, is this
+/// far below the output's estimated peak [dB] (16-bit PCM resolves −96 dB).
+pub const SILENCE_DB: f64 = -100.0;
 /// Samples rendered per voice call.
 const RENDER_CHUNK: usize = 4096;
 
@@ -80,6 +87,9 @@ pub struct ObjectReport {
     pub samples_computed: u64,
     /// Peak of the object's radiated pressure at 1 m [Pa].
     pub peak_pa_at_1m: f64,
+    /// Centre of mass when the simulation ended (end of the scene, or when
+    /// every body fell asleep) [m].
+    pub final_position_m: [f64; 3],
 }
 
 /// What a render did.
@@ -144,6 +154,8 @@ pub fn render(
     provider: &mut dyn BankProvider,
     opts: &RenderOptions,
 ) -> Result<Rendered, SceneError> {
+    let original = scene;
+    let scene = &*with_slab(original);
     let mut report = RenderReport {
         duration_s: scene.duration_s,
         sample_rate: scene.sample_rate_hz,
@@ -153,7 +165,7 @@ pub fn render(
     let (banks, requested) = resolve_banks(scene, provider)?;
     report.banks_requested = requested;
     report.banks_s = t.elapsed().as_secs_f64();
-    check_ground_clearance(scene, &banks)?;
+    check_ground_clearance(original, &banks[..original.objects.len()])?;
 
     let names: Vec<String> = (0..scene.objects.len()).map(|i| scene.object_name(i)).collect();
     let sim = simulate(scene, &banks, &names, opts, &mut report)?;
@@ -161,7 +173,7 @@ pub fn render(
     let t = Instant::now();
     let fs = scene.sample_rate_hz as f64;
     let total = (scene.duration_s * fs).round() as usize;
-    let signals = synthesize(scene, &banks, &names, &sim.strikes, total)?;
+    let signals = synthesize(scene, &banks, &names, &sim.strikes, &sim.trajectories, total)?;
     report.synthesis_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -174,6 +186,7 @@ pub fn render(
             name: names[i].clone(),
             impacts: sim.impacts[i],
             strikes: sim.strikes[i].len(),
+            final_position_m: sim.trajectories[i].positions.last().map_or([0.0; 3], |p| p.map(f64::from)),
             ..s.report.clone()
         });
     }
@@ -225,6 +238,7 @@ fn simulate(
         let t = Instant::now();
         world.step();
         world.contacts(&mut pairs);
+        world.resist_rolling(&pairs);
         report.physics_s += t.elapsed().as_secs_f64();
         report.physics_steps += 1;
         let t = Instant::now();
@@ -262,20 +276,71 @@ fn synthesize(
     banks: &[Arc<ModeBank>],
     names: &[String],
     strikes: &[Vec<Strike>],
+    paths: &[Trajectory],
     total: usize,
 ) -> Result<Vec<Signal>, SceneError> {
-    // One checked model and one set of radiation gains per distinct bank.
+    let per_object = shared_models(banks, names, strikes)?;
+    let fs = scene.sample_rate_hz as f64;
+    let ears = ears(scene);
+    // Phase 1: every struck voice up to its last strike (its peak is known then).
+    let mut runs: Vec<Option<VoiceRun>> = (0..banks.len())
+        .into_par_iter()
+        .map(|i| -> Result<Option<VoiceRun>, SceneError> {
+            let Some((model, gains)) = &per_object[i] else { return Ok(None) };
+            let opts = SynthOptions {
+                sample_rate: fs,
+                gain: OutputGain::PerMode(gains.to_vec()),
+                parallel: false,
+                ..SynthOptions::default()
+            };
+            let voice = ModalVoice::from_model(Arc::clone(model), opts)
+                .map_err(|e| SceneError::Synthesis { object: names[i].clone(), message: e.to_string() })?;
+            let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
+            let (near, far) = distance_range(&paths[i], &ears);
+            Ok(VoiceRun::start(voice, &strikes[i], total, fs, scale, near, far).map(|mut run| {
+                run.render_strikes(total);
+                run
+            }))
+        })
+        .collect::<Result<_, _>>()?;
+    // Phase 2: each voice until it is SILENCE_DB below the output's peak.
+    let gain = scene.listener.gain;
+    let reference =
+        runs.iter().flatten().map(|r| r.peak as f64 * r.scale * gain / r.far_m).fold(0.0, f64::max);
+    let stop_level = reference * 10f64.powf(SILENCE_DB / 20.0);
+    runs.par_iter_mut()
+        .flatten()
+        .for_each(|run| run.render_tail(total, stop_level / (run.scale * gain / run.near_m)));
+    Ok(runs
+        .into_iter()
+        .enumerate()
+        .map(|(i, run)| {
+            let report = ObjectReport { modes_total: banks[i].mode_count(), ..Default::default() };
+            match run {
+                Some(run) => run.finish(report),
+                None => Signal { start: 0, samples: Vec::new(), report },
+            }
+        })
+        .collect())
+}
+
+/// One checked synthesis model and its radiation gains per distinct bank,
+/// `None` for objects never struck.
+fn shared_models(
+    banks: &[Arc<ModeBank>],
+    names: &[String],
+    strikes: &[Vec<Strike>],
+) -> Result<Vec<Option<SharedModel>>, SceneError> {
     let mut models: Vec<(*const ModeBank, SharedModel)> = Vec::new();
     let mut per_object = Vec::with_capacity(banks.len());
     for (i, bank) in banks.iter().enumerate() {
+        if strikes[i].is_empty() {
+            per_object.push(None);
+            continue;
+        }
         let key = Arc::as_ptr(bank);
-        let found = models.iter().position(|m| m.0 == key);
-        let idx = match found {
+        let idx = match models.iter().position(|m| m.0 == key) {
             Some(idx) => idx,
-            None if strikes[i].is_empty() => {
-                per_object.push(None);
-                continue;
-            }
             None => {
                 let model = SynthModel::new(bank).map_err(|e| SceneError::Synthesis {
                     object: names[i].clone(),
@@ -289,26 +354,23 @@ fn synthesize(
         let (model, gains) = &models[idx].1;
         per_object.push(Some((Arc::clone(model), Arc::clone(gains))));
     }
-    let fs = scene.sample_rate_hz as f64;
-    (0..banks.len())
-        .into_par_iter()
-        .map(|i| {
-            let report = ObjectReport { modes_total: banks[i].mode_count(), ..Default::default() };
-            let Some((model, gains)) = &per_object[i] else {
-                return Ok(Signal { start: 0, samples: Vec::new(), report });
-            };
-            let opts = SynthOptions {
-                sample_rate: fs,
-                gain: OutputGain::PerMode(gains.to_vec()),
-                parallel: false,
-                ..SynthOptions::default()
-            };
-            let voice = ModalVoice::from_model(Arc::clone(model), opts)
-                .map_err(|e| SceneError::Synthesis { object: names[i].clone(), message: e.to_string() })?;
-            let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
-            Ok(render_voice(voice, &strikes[i], total, fs, scale, report))
-        })
-        .collect()
+    Ok(per_object)
+}
+
+/// Nearest and farthest distance [m] between an object's path and the ears
+/// (clamped below at [`crate::MIN_DISTANCE_M`]).
+fn distance_range(path: &Trajectory, ears: &[[f64; 3]]) -> (f64, f64) {
+    let mut range = (f64::INFINITY, 0.0f64);
+    for p in &path.positions {
+        for e in ears {
+            let r = (0..3).map(|c| (p[c] as f64 - e[c]).powi(2)).sum::<f64>().sqrt();
+            range = (range.0.min(r), range.1.max(r));
+        }
+    }
+    if path.positions.is_empty() || ears.is_empty() {
+        range = (1.0, 1.0);
+    }
+    (range.0.max(crate::MIN_DISTANCE_M), range.1.max(crate::MIN_DISTANCE_M))
 }
 
 /// Per-mode output gains: RMS normal shape × the sphere's radiation roll-off.
@@ -344,55 +406,116 @@ fn equivalent_radius(bank: &ModeBank) -> f64 {
     (area / (4.0 * std::f64::consts::PI)).sqrt()
 }
 
-fn render_voice(
-    mut voice: ModalVoice,
-    strikes: &[Strike],
-    total: usize,
-    fs: f64,
+/// A voice being rendered in chunks of [`RENDER_CHUNK`] samples.
+struct VoiceRun {
+    voice: ModalVoice,
+    /// Output sample index of `samples[0]`.
+    start: usize,
+    /// Next output sample to render.
+    pos: usize,
+    /// The sample after which no strike is pending.
+    last_sample: usize,
+    /// Voice output so far (synthesizer units).
+    samples: Vec<f32>,
+    /// Largest |sample| so far (synthesizer units).
+    peak: f32,
+    /// Synthesizer units → pressure at 1 m / [`FULL_SCALE_PA`].
     scale: f64,
-    mut report: ObjectReport,
-) -> Signal {
-    let mut last = 0.0f64;
-    let mut first = f64::INFINITY;
-    for s in strikes {
-        match voice.add_impulse(s.time_s, s.point_m, s.impulse_ns, s.contact_time_s) {
-            Ok(_) => {
-                first = first.min(s.time_s);
-                last = last.max(s.time_s + s.contact_time_s);
+    /// Nearest / farthest distance to an ear [m].
+    near_m: f64,
+    far_m: f64,
+    strikes_dropped: usize,
+}
+
+impl VoiceRun {
+    /// Applies the strikes; `None` when none of them landed.
+    fn start(
+        mut voice: ModalVoice,
+        strikes: &[Strike],
+        total: usize,
+        fs: f64,
+        scale: f64,
+        near_m: f64,
+        far_m: f64,
+    ) -> Option<VoiceRun> {
+        let (mut first, mut last, mut dropped) = (f64::INFINITY, 0.0f64, 0);
+        for s in strikes {
+            match voice.add_impulse(s.time_s, s.point_m, s.impulse_ns, s.contact_time_s) {
+                Ok(_) => {
+                    first = first.min(s.time_s);
+                    last = last.max(s.time_s + s.contact_time_s);
+                }
+                Err(_) => dropped += 1,
             }
-            Err(_) => report.strikes_dropped += 1,
+        }
+        let start = ((first * fs).floor() as usize).min(total);
+        let last_sample = (last * fs).ceil() as usize + 1;
+        let run = VoiceRun {
+            voice,
+            start,
+            pos: start,
+            last_sample,
+            samples: Vec::new(),
+            peak: 0.0,
+            scale,
+            near_m,
+            far_m,
+            strikes_dropped: dropped,
+        };
+        first.is_finite().then_some(run)
+    }
+
+    /// Renders one chunk; returns its peak.
+    fn chunk(&mut self, total: usize) -> f32 {
+        let len = RENDER_CHUNK.min(total - self.pos);
+        let at = self.samples.len();
+        self.samples.resize(at + len, 0.0);
+        self.voice.render(&mut self.samples[at..], self.pos as u64);
+        let block_peak = self.samples[at..].iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        self.peak = self.peak.max(block_peak);
+        self.pos += len;
+        block_peak
+    }
+
+    /// Renders until every strike has been applied.
+    fn render_strikes(&mut self, total: usize) {
+        while self.pos < total && self.pos <= self.last_sample {
+            self.chunk(total);
         }
     }
-    if !first.is_finite() {
-        return Signal { start: 0, samples: Vec::new(), report };
-    }
-    let start = ((first * fs).floor() as usize).min(total);
-    let last_sample = (last * fs).ceil() as usize + 1;
-    let mut samples: Vec<f32> = Vec::new();
-    let mut peak = 0.0f32;
-    let floor = 10f32.powf((SILENCE_DB / 20.0) as f32);
-    let mut pos = start;
-    while pos < total {
-        let len = RENDER_CHUNK.min(total - pos);
-        let at = samples.len();
-        samples.resize(at + len, 0.0);
-        voice.render(&mut samples[at..], pos as u64);
-        let block_peak = samples[at..].iter().fold(0.0f32, |m, x| m.max(x.abs()));
-        peak = peak.max(block_peak);
-        pos += len;
-        if pos > last_sample && (voice.is_silent() || block_peak <= floor * peak) {
-            break;
+
+    /// Renders until a chunk peaks below `floor` (synthesizer units) or the
+    /// voice falls silent, then fades that last chunk out (no click).
+    fn render_tail(&mut self, total: usize, floor: f64) {
+        while self.pos < total {
+            if self.voice.is_silent() {
+                return;
+            }
+            let at = self.samples.len();
+            if (self.chunk(total) as f64) <= floor {
+                let tail = &mut self.samples[at..];
+                let n = tail.len();
+                for (j, x) in tail.iter_mut().enumerate() {
+                    let g = 0.5 * (1.0 + (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos());
+                    *x = (*x as f64 * g) as f32;
+                }
+                return;
+            }
         }
     }
-    for x in &mut samples {
-        *x = (*x as f64 * scale) as f32;
+
+    fn finish(mut self, mut report: ObjectReport) -> Signal {
+        for x in &mut self.samples {
+            *x = (*x as f64 * self.scale) as f32;
+        }
+        let stats = self.voice.stats();
+        report.strikes_dropped = self.strikes_dropped;
+        report.modes_synthesized = stats.modes_total - stats.modes_skipped;
+        report.mode_samples = stats.mode_samples;
+        report.samples_computed = self.samples.len() as u64;
+        report.peak_pa_at_1m = self.peak as f64 * self.scale * FULL_SCALE_PA;
+        Signal { start: self.start, samples: self.samples, report }
     }
-    let stats = voice.stats();
-    report.modes_synthesized = stats.modes_total - stats.modes_skipped;
-    report.mode_samples = stats.mode_samples;
-    report.samples_computed = samples.len() as u64;
-    report.peak_pa_at_1m = peak as f64 * scale * FULL_SCALE_PA;
-    Signal { start, samples, report }
 }
 
 /// Ear positions of the listener.
@@ -416,7 +539,7 @@ fn ears(scene: &Scene) -> Vec<[f64; 3]> {
 fn mix(scene: &Scene, signals: &[Signal], paths: &[Trajectory], total: usize) -> Vec<Vec<f32>> {
     let fs = scene.sample_rate_hz as f64;
     ears(scene)
-        .into_iter()
+        .into_par_iter()
         .map(|ear| {
             let mut out = vec![0.0f32; total];
             for (s, path) in signals.iter().zip(paths) {

@@ -91,7 +91,9 @@ impl Default for ListenerSpec {
     }
 }
 
-/// The floor: a silent, infinite plane `y = height` (TOML table `[ground]`).
+/// The floor (TOML table `[ground]`): a silent, infinite plane `y = height`,
+/// or, when `size` is given, a finite sounding slab whose top face lies at
+/// `y = height` (a fixed box whose mode bank comes from the provider).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {
@@ -107,7 +109,23 @@ pub struct GroundSpec {
     /// Restitution coefficient (default 0.3).
     #[serde(default = "defaults::restitution")]
     pub restitution: f64,
+    /// Slab extents along x and z [m] (`size`); absent = infinite silent plane.
+    #[serde(rename = "size", default)]
+    pub size_m: Option<[f64; 2]>,
+    /// Slab thickness [m] (`thickness`, default [`DEFAULT_SLAB_THICKNESS_M`]).
+    #[serde(rename = "thickness", default = "defaults::slab_thickness")]
+    pub thickness_m: f64,
+    /// Centre of the slab's top face in x and z [m] (`center`, default `[0, 0]`).
+    #[serde(rename = "center", default)]
+    pub center_m: [f64; 2],
+    /// Target element edge length of the slab's mesh [m] (`element_size`,
+    /// default: the thickness).
+    #[serde(rename = "element_size", default)]
+    pub element_size_m: Option<f64>,
 }
+
+/// Default thickness of a sounding ground slab [m].
+pub const DEFAULT_SLAB_THICKNESS_M: f64 = 0.02;
 
 /// Whether a body moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
@@ -119,6 +137,25 @@ pub enum BodyKind {
     /// Never moves (a table, a floor that sounds).
     Fixed,
 }
+
+/// The collision shape of a dynamic body (TOML key `collider`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ColliderKind {
+    /// The convex hull of the surface (cheap; fills every cavity).
+    #[default]
+    Hull,
+    /// An approximate convex decomposition of the surface (parry's VHACD):
+    /// cavities stay open, so a bowl can hold a ball. Costs time at set-up.
+    Decomposition,
+    /// `decomposition` when the hull's volume exceeds the mesh volume by
+    /// more than [`AUTO_DECOMPOSITION_RATIO`], else `hull`.
+    Auto,
+}
+
+/// `collider = "auto"` decomposes a body whose convex hull is more than this
+/// many times its own volume (a bowl: ≈ 5; a box or sphere: ≈ 1).
+pub const AUTO_DECOMPOSITION_RATIO: f64 = 1.5;
 
 /// A mesh asset: a file path or a generator recipe.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -310,6 +347,10 @@ pub struct ObjectSpec {
     /// `"dynamic"` (default) or `"fixed"`.
     #[serde(default)]
     pub body: BodyKind,
+    /// Collision shape of a dynamic body (`collider`, default `"hull"`);
+    /// fixed bodies always collide with their surface triangle mesh.
+    #[serde(default)]
+    pub collider: ColliderKind,
     /// Coulomb friction coefficient (default 0.5; a contact uses the mean of both).
     #[serde(default = "defaults::friction")]
     pub friction: f64,
@@ -319,7 +360,17 @@ pub struct ObjectSpec {
     /// Hertz contact radius [m] (default: half the smallest bounding-box extent).
     #[serde(rename = "contact_radius", default)]
     pub contact_radius_m: Option<f64>,
+    /// Rolling-resistance lever arm `b` [m] (`rolling_resistance`, default
+    /// [`DEFAULT_ROLLING_RESISTANCE_M`]): while touching, the body feels a
+    /// torque `b·N` opposing its rotation (module `physics`).
+    #[serde(rename = "rolling_resistance", default = "defaults::rolling_resistance")]
+    pub rolling_resistance_m: f64,
 }
+
+/// Default rolling-resistance lever arm [m]: 1 mm, a rolling-resistance
+/// coefficient `b/R` ≈ 0.01–0.02 for bodies of 5–10 cm radius, the range
+/// quoted for hard objects (glass, ceramic, metal) rolling on a wooden table.
+pub const DEFAULT_ROLLING_RESISTANCE_M: f64 = 1e-3;
 
 mod defaults {
     use super::MaterialSpec;
@@ -358,6 +409,12 @@ mod defaults {
     }
     pub fn restitution() -> f64 {
         0.3
+    }
+    pub fn slab_thickness() -> f64 {
+        super::DEFAULT_SLAB_THICKNESS_M
+    }
+    pub fn rolling_resistance() -> f64 {
+        super::DEFAULT_ROLLING_RESISTANCE_M
     }
 }
 

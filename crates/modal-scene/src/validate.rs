@@ -42,6 +42,17 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
         resolve_material(&g.material).map_err(|m| SceneError::invalid("ground.material", m))?;
         non_negative("ground.friction", g.friction)?;
         unit_interval("ground.restitution", g.restitution)?;
+        positive("ground.thickness", g.thickness_m)?;
+        if let Some(size) = g.size_m {
+            for (c, v) in size.iter().enumerate() {
+                positive(&format!("ground.size[{c}]"), *v)?;
+            }
+        }
+        finite("ground.center[0]", g.center_m[0])?;
+        finite("ground.center[1]", g.center_m[1])?;
+        if let Some(h) = g.element_size_m {
+            positive("ground.element_size", h)?;
+        }
     }
     if scene.objects.len() > MAX_OBJECTS {
         return Err(SceneError::invalid("objects", format!("at most {MAX_OBJECTS} objects")));
@@ -102,6 +113,7 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
     finite3(&key("angular_velocity"), o.angular_velocity_rad_s)?;
     non_negative(&key("friction"), o.friction)?;
     unit_interval(&key("restitution"), o.restitution)?;
+    non_negative(&key("rolling_resistance"), o.rolling_resistance_m)?;
     if let Some(r) = o.contact_radius_m {
         positive(&key("contact_radius"), r)?;
     }

@@ -1,0 +1,171 @@
+//! Issue 5 points 1 and 3: a ground that sounds, concave bodies through a
+//! convex decomposition, and bodies that come to rest and sleep.
+
+mod common;
+
+use std::path::Path;
+
+use modal_fem::Material;
+use modal_scene::{render, InMemoryProvider, RenderOptions, Scene, GROUND_NAME};
+
+/// A steel ball dropped on a sounding wooden slab (the `[ground]` with a `size`).
+const BALL_ON_SOUNDING_GROUND: &str = r#"
+duration = 0.6
+sample_rate = 16000
+[listener]
+position = [0.0, 0.3, 0.5]
+channels = "mono"
+[ground]
+material = "wood"
+size = [0.4, 0.3]
+thickness = 0.03
+[[objects]]
+name = "ball"
+mesh = { generate = "sphere", radius = 0.02 }
+material = "steel"
+position = [0.0, 0.12, 0.0]
+"#;
+
+#[test]
+fn a_sounding_ground_rings_at_its_bank_frequencies() {
+    let scene = Scene::from_toml_str(BALL_ON_SOUNDING_GROUND, Path::new(".")).expect("scene");
+    let mut p = InMemoryProvider::new();
+    p.insert("sphere", common::ball(0.02, &[3100.0]));
+    p.insert("box", common::block([0.4, 0.03, 0.3], &[500.0, 800.0]));
+    let out = render(&scene, &mut p, &RenderOptions { collect_events: true }).expect("render");
+    // The slab is asked from the provider as a generated box of the ground's material.
+    let slab = p.requests.iter().find(|r| r.mesh.as_ref().is_some_and(|m| format!("{m:?}").contains("box")));
+    let slab = slab.expect("a bank request for the slab");
+    assert_eq!(slab.material, Some(Material::preset("wood").expect("wood")));
+    let ground = out.report.objects.iter().find(|o| o.name == GROUND_NAME).expect("ground in the report");
+    assert!(ground.impacts >= 1 && ground.peak_pa_at_1m > 0.0, "{ground:?}");
+    assert!(out.events.iter().any(|e| e.bodies.contains(&GROUND_NAME.to_string())));
+    // The ball lands on the slab's top face (y = 0) after √(2h/g).
+    let first = out.events.first().expect("an impact");
+    assert!((first.time_s - (2.0 * 0.1 / 9.81f64).sqrt()).abs() < 2e-3, "{first:?}");
+    assert!(first.point_m[1].abs() < 2e-3, "{first:?}");
+
+    let y = &out.channels[0];
+    let n = 4096;
+    let start = common::onset(y, 1e-2).expect("sound");
+    let spec = common::spectrum(&y[start..start + n]);
+    let bin = 16000.0 / n as f64;
+    let level = |f: f64| {
+        let k = (f / bin).round() as usize;
+        spec[k - 2..=k + 2].iter().cloned().fold(0.0, f64::max)
+    };
+    let floor = {
+        let mut s = spec.clone();
+        s.sort_by(f64::total_cmp);
+        s[s.len() / 2]
+    };
+    // The slab's two modes (wood damps fast, so they stay low) and the ball's.
+    for f in [500.0, 800.0, 3100.0] {
+        assert!(level(f) > 100.0 * floor, "no spectral peak at {f} Hz: {} vs median {floor}", level(f));
+    }
+    // Nothing where neither body has a mode.
+    assert!(level(2000.0) < 0.05 * level(500.0).min(level(800.0)));
+}
+
+/// A glass bowl (opening up) resting on the floor and a small steel ball
+/// dropped into it from above its centre.
+fn ball_into_bowl(collider: &str) -> String {
+    format!(
+        r#"
+duration = 1.5
+sample_rate = 16000
+[listener]
+channels = "mono"
+[ground]
+[[objects]]
+name = "bowl"
+mesh = {{ generate = "bowl", radius = 0.06, thickness = 0.004 }}
+material = "glass"
+position = [0.0, 0.0335, 0.0]
+rotation = {{ euler = [-90.0, 0.0, 0.0] }}
+collider = "{collider}"
+[[objects]]
+name = "ball"
+mesh = {{ generate = "sphere", radius = 0.01 }}
+material = "steel"
+position = [0.003, 0.12, 0.0]
+"#
+    )
+}
+
+fn bowl_provider() -> InMemoryProvider {
+    let glass = Material::preset("glass").expect("glass");
+    let bowl = modal_mesh::generate::bowl(0.06, 0.004, 0.008, 1).expect("bowl mesh");
+    let mut p = InMemoryProvider::new();
+    p.insert("bowl", common::bank_on(&bowl, glass, &[900.0, 2100.0]));
+    p.insert("sphere", common::ball(0.01, &[4000.0]));
+    p
+}
+
+/// Final centres of mass of the bowl and the ball [m].
+fn final_positions(collider: &str) -> [[f64; 3]; 2] {
+    let scene = Scene::from_toml_str(&ball_into_bowl(collider), Path::new(".")).expect("scene");
+    let out = render(&scene, &mut bowl_provider(), &RenderOptions::default()).expect("render");
+    let at = |k: usize| out.report.objects[k].final_position_m;
+    eprintln!(
+        "{collider}: bowl ends at {:?}, ball at {:?} ({} steps)",
+        at(0),
+        at(1),
+        out.report.physics_steps
+    );
+    [at(0), at(1)]
+}
+
+/// Whether the ball ended inside the bowl: below the rim, above the inner
+/// bottom, within the rim's radius of the bowl's axis.
+fn inside(collider: &str) -> bool {
+    let [bowl, ball] = final_positions(collider);
+    // The rim (the shell's sphere centre) lies ≈ 0.029 m above the bowl's
+    // centre of mass; the inner bottom ≈ 0.031 m below the rim.
+    let rim = bowl[1] + 0.029;
+    let off_axis = ((ball[0] - bowl[0]).powi(2) + (ball[2] - bowl[2]).powi(2)).sqrt();
+    ball[1] < rim - 0.01 && ball[1] > rim - 0.056 + 0.008 && off_axis < 0.05
+}
+
+#[test]
+fn a_ball_comes_to_rest_inside_a_decomposed_bowl() {
+    // Inside, the 1 cm ball's centre sits near the inner bottom (y ≈ 0.014 m);
+    // on the convex hull's flat lid (the rim plane, y ≈ 0.062 m) at ≈ 0.072 m.
+    assert!(inside("decomposition"), "the ball is not inside the decomposed bowl");
+    let [bowl, ball] = final_positions("hull");
+    assert!(ball[1] > bowl[1] + 0.029 + 0.008, "with a hull the ball cannot enter the bowl: {ball:?}");
+    // `auto` sees a hull ≈ 5× the shell's volume and decomposes.
+    assert!(inside("auto"));
+}
+
+#[test]
+fn a_rocking_bowl_comes_to_rest_and_the_physics_stops() {
+    // Dropped tilted, the bowl lands on its rim side and rocks on its hull;
+    // rolling resistance (default 1 mm) must bring it to rest well within
+    // the 4 s so that it sleeps and the remaining steps are skipped.
+    let text = r#"
+duration = 4.0
+sample_rate = 16000
+[listener]
+channels = "mono"
+[ground]
+[[objects]]
+name = "bowl"
+mesh = { generate = "bowl", radius = 0.06, thickness = 0.004 }
+material = "glass"
+position = [0.0, 0.1, 0.0]
+rotation = { euler = [-70.0, 0.0, 10.0] }
+angular_velocity = [0.0, 2.0, 1.0]
+"#;
+    let scene = Scene::from_toml_str(text, Path::new(".")).expect("scene");
+    let out = render(&scene, &mut bowl_provider(), &RenderOptions::default()).expect("render");
+    let steps = out.report.physics_steps;
+    eprintln!("{steps} physics steps of 4000");
+    assert!(steps < 3000, "the bowl did not come to rest: {steps} steps");
+    // Without rolling resistance it rocks on (and sleeps later, if at all).
+    let free = text.replace("angular_velocity", "rolling_resistance = 0.0\nangular_velocity");
+    let scene = Scene::from_toml_str(&free, Path::new(".")).expect("scene");
+    let out = render(&scene, &mut bowl_provider(), &RenderOptions::default()).expect("render");
+    eprintln!("without rolling resistance: {} steps", out.report.physics_steps);
+    assert!(out.report.physics_steps > steps + 500, "{} steps", out.report.physics_steps);
+}
