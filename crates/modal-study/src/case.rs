@@ -5,8 +5,9 @@
 //! rigid-body fields), `factor` (ordering + symbolic + numeric Cholesky of K − σM, from
 //! the eigensolver's own [`modal_eigen::SolveStats`]) and `solve` (Krylov–Schur iteration
 //! plus inertia and residual checks). Mesh levels refine geometrically:
-//! `h_k = h_0 · 2^(−k/2)` (k = 0, 1, …), with `h_0` per shape and order chosen so that
-//! the default five levels end near 10⁵ DOF for both orders.
+//! `h_k = h_0 · 2^(−k/2)` (k = 0, 1, …), so each level has ≈2.8× the DOFs of the previous;
+//! `h_0` per shape and order is chosen so that five levels end at 4·10⁴–10⁵ DOF for both
+//! orders (TET4 starts one halving finer than TET10: 8× fewer nodes per volume).
 
 use crate::compare::{compare_sorted, Comparison};
 use crate::reference::{self, BAR_SIZE, SPHERE_RADIUS, STEEL_E_PA, STEEL_NU, STEEL_RHO};
@@ -91,8 +92,9 @@ impl StudyShape {
         let d = self.smallest_dimension_m();
         let per_d = match self {
             StudyShape::Bar | StudyShape::Cantilever => 1.0,
-            // The compact sphere holds far fewer elements per D³ than the slender bar.
-            StudyShape::Sphere => 5.0,
+            // The compact sphere holds far more elements per D than the slender bar, and its
+            // O-grid mesh is denser than V/h³: start at D/2.5.
+            StudyShape::Sphere => 2.5,
         };
         // Linear tets have 8× fewer nodes per element volume: start one halving finer.
         let order_factor = if order == 1 { 2.0 } else { 1.0 };
