@@ -107,35 +107,63 @@ impl StudyShape {
     }
 }
 
-/// What to run: one shape, element order (1 or 2) and mesh level.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// What to run: one shape, element order (1 or 2) and mesh level (or an explicit size).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseSpec {
     /// The shape.
     pub shape: StudyShape,
     /// Element order: 1 (TET4) or 2 (TET10).
     pub order: u8,
-    /// Mesh level (0 = coarsest).
+    /// Mesh level (0 = coarsest), see [`StudyShape::level_h_m`].
     pub level: usize,
+    /// Element size (m) replacing the level's, to measure one specific rule (e.g. `D/5`).
+    #[serde(default)]
+    pub h_override_m: Option<f64>,
 }
 
 impl CaseSpec {
-    /// Parses `shape:order:level`, e.g. `bar:2:3`.
+    /// A case on the level ladder.
+    pub fn new(shape: StudyShape, order: u8, level: usize) -> CaseSpec {
+        CaseSpec { shape, order, level, h_override_m: None }
+    }
+
+    /// Parses `shape:order:level` (e.g. `bar:2:3`) or `shape:order:h=<mm>` (e.g. `bar:2:h=2`).
     pub fn parse(text: &str) -> Result<CaseSpec, StudyError> {
         let bad = || StudyError::BadCase(text.to_string());
         let parts: Vec<&str> = text.split(':').collect();
-        let [shape, order, level] = parts[..] else { return Err(bad()) };
+        let [shape, order, size] = parts[..] else { return Err(bad()) };
         let shape = StudyShape::from_name(shape)?;
         let order: u8 = order.parse().map_err(|_| bad())?;
-        let level: usize = level.parse().map_err(|_| bad())?;
-        if !(1..=2).contains(&order) || level > 20 {
+        if !(1..=2).contains(&order) {
             return Err(bad());
         }
-        Ok(CaseSpec { shape, order, level })
+        if let Some(mm) = size.strip_prefix("h=") {
+            let mm: f64 = mm.parse().map_err(|_| bad())?;
+            // Below 1/100 of the smallest dimension a case would not fit in memory.
+            let min_mm = shape.smallest_dimension_m() * 10.0;
+            if !(mm.is_finite() && mm >= min_mm && mm <= 1e3) {
+                return Err(bad());
+            }
+            return Ok(CaseSpec { shape, order, level: 0, h_override_m: Some(mm * 1e-3) });
+        }
+        let level: usize = size.parse().map_err(|_| bad())?;
+        if level > 20 {
+            return Err(bad());
+        }
+        Ok(CaseSpec::new(shape, order, level))
     }
 
-    /// The `shape:order:level` text [`CaseSpec::parse`] reads.
+    /// The text [`CaseSpec::parse`] reads.
     pub fn label(&self) -> String {
-        format!("{}:{}:{}", self.shape.name(), self.order, self.level)
+        match self.h_override_m {
+            Some(h) => format!("{}:{}:h={}", self.shape.name(), self.order, h * 1e3),
+            None => format!("{}:{}:{}", self.shape.name(), self.order, self.level),
+        }
+    }
+
+    /// Element size (m) of this case.
+    pub fn h_m(&self) -> f64 {
+        self.h_override_m.unwrap_or_else(|| self.shape.level_h_m(self.order, self.level))
     }
 }
 
@@ -189,7 +217,7 @@ pub fn study_material() -> Material {
 pub fn run_case(spec: CaseSpec) -> Result<CaseResult, StudyError> {
     let start = Instant::now();
     let shape = spec.shape;
-    let h = shape.level_h_m(spec.order, spec.level);
+    let h = spec.h_m();
     let mesh = modal_mesh::generate::generate(&shape.geometry(), h, spec.order)?;
     let mesh_s = start.elapsed().as_secs_f64();
 

@@ -46,9 +46,18 @@ fn cantilever_reference_agrees_with_timoshenko_for_slender_bending() {
 #[test]
 fn case_spec_round_trip_and_bad_text() {
     let spec = CaseSpec::parse("cantilever:1:4").expect("valid");
-    assert_eq!(spec, CaseSpec { shape: StudyShape::Cantilever, order: 1, level: 4 });
+    assert_eq!(spec, CaseSpec::new(StudyShape::Cantilever, 1, 4));
     assert_eq!(spec.label(), "cantilever:1:4");
-    for bad in ["bar:3:1", "bar:2", "cube:2:1", "bar:2:x", "bar:2:99"] {
+    let sized = CaseSpec::parse("bar:2:h=2.5").expect("valid");
+    assert_eq!(sized.label(), "bar:2:h=2.5");
+    assert!((sized.h_m() - 2.5e-3).abs() < 1e-15);
+    assert!(
+        (sized.h_m() - StudyShape::Bar.level_h_m(2, 4)).abs() < 1e-15,
+        "D/4 is level 4 of the TET10 bar ladder"
+    );
+    for bad in
+        ["bar:3:1", "bar:2", "cube:2:1", "bar:2:x", "bar:2:99", "bar:2:h=0.01", "bar:2:h=nan", "bar:2:h=-1"]
+    {
         assert!(CaseSpec::parse(bad).is_err(), "{bad}");
     }
 }
@@ -61,7 +70,7 @@ fn tiny_bar_study_converges_and_tet10_wins() {
     let mut cases = Vec::new();
     for order in [1u8, 2] {
         for level in 0..2 {
-            let case = run_case(CaseSpec { shape: StudyShape::Bar, order, level }).expect("case runs");
+            let case = run_case(CaseSpec::new(StudyShape::Bar, order, level)).expect("case runs");
             assert_eq!(case.comparison.missing, 0);
             assert_eq!(case.comparison.relative_errors.len(), 12);
             cases.push(case);

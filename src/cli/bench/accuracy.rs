@@ -44,7 +44,8 @@ pub struct AccuracyBenchArgs {
     /// Max relative error the mesh-size recommendation aims for.
     #[arg(long, default_value_t = 0.01)]
     target_error: f64,
-    /// Run one case (shape:order:level) in this process and print it as one JSON line.
+    /// Run one case (shape:order:level or shape:order:h=<mm>) in this process and print it
+    /// as one JSON line.
     #[arg(long, hide = true)]
     case: Option<String>,
 }
@@ -95,7 +96,7 @@ fn plan(args: &AccuracyBenchArgs) -> Result<Vec<CaseSpec>> {
     let mut specs = Vec::new();
     for &shape in &shapes {
         for &order in &args.orders {
-            specs.extend((0..args.levels).map(|level| CaseSpec { shape, order, level }));
+            specs.extend((0..args.levels).map(|level| CaseSpec::new(shape, order, level)));
         }
     }
     Ok(specs)
