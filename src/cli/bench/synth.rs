@@ -159,14 +159,15 @@ fn run_material(material: &'static str, args: &SynthBenchArgs) -> anyhow::Result
 /// Cost (wall seconds per audio second) vs relative RMS error, one curve per
 /// material and family of variants: f32 SIMD culling sweep (off, −100, −80,
 /// −60 dB), f32 SIMD budgets (at −100 dB, with the unlimited point), the f64
-/// scalar path (off, −100 dB) and the portable f32 kernel (culling off).
+/// scalar path (off, −100 dB) and the portable ("plain", no run-time SIMD
+/// dispatch) f32 kernel (culling off).
 /// Labels stay short: the legend has room for about 20 characters.
 fn plot_series(materials: &[MaterialReport]) -> Vec<Series> {
     let families: [(&str, fn(&Row) -> bool); 4] = [
         ("f32 cull", |r| r.kernel == "f32_simd" && r.budget.is_none()),
         ("f32 budget", |r| r.kernel == "f32_simd" && (r.budget.is_some() || r.cull_db == Some(-100.0))),
         ("f64 scalar", |r| r.kernel == "f64_scalar"),
-        ("f32 portable", |r| r.kernel == "f32_portable"),
+        ("f32 plain", |r| r.kernel == "f32_portable"),
     ];
     let mut series = Vec::new();
     for m in materials {
@@ -178,7 +179,7 @@ fn plot_series(materials: &[MaterialReport]) -> Vec<Series> {
                 .map(|r| (1.0 / r.realtime_factor, r.rel_rms_error))
                 .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            series.push(Series { label: format!("{}: {name}", m.material), points });
+            series.push(Series { label: format!("{} {name}", m.material), points });
         }
     }
     series
