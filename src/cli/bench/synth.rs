@@ -156,6 +156,9 @@ fn run_material(material: &'static str, args: &SynthBenchArgs) -> anyhow::Result
     Ok(MaterialReport { material, reference_terms, reference_wall_s, peak, rows })
 }
 
+/// Selects the rows of one plotted curve.
+type RowFilter = fn(&Row) -> bool;
+
 /// Cost (wall seconds per audio second) vs relative RMS error, one curve per
 /// material and family of variants: f32 SIMD culling sweep (off, −100, −80,
 /// −60 dB), f32 SIMD budgets (at −100 dB, with the unlimited point), the f64
@@ -163,7 +166,7 @@ fn run_material(material: &'static str, args: &SynthBenchArgs) -> anyhow::Result
 /// dispatch) f32 kernel (culling off).
 /// Labels stay short: the legend has room for about 20 characters.
 fn plot_series(materials: &[MaterialReport]) -> Vec<Series> {
-    let families: [(&str, fn(&Row) -> bool); 4] = [
+    let families: [(&str, RowFilter); 4] = [
         ("f32 cull", |r| r.kernel == "f32_simd" && r.budget.is_none()),
         ("f32 budget", |r| r.kernel == "f32_simd" && (r.budget.is_some() || r.cull_db == Some(-100.0))),
         ("f64 scalar", |r| r.kernel == "f64_scalar"),
