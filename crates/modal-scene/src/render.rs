@@ -105,6 +105,8 @@ pub struct RenderReport {
     pub impacts: usize,
     /// Seconds getting banks.
     pub banks_s: f64,
+    /// Seconds building bodies and colliders (convex hulls, decompositions).
+    pub colliders_s: f64,
     /// Seconds in rapier.
     pub physics_s: f64,
     /// Seconds turning contacts into strikes.
@@ -212,7 +214,9 @@ fn simulate(
     report: &mut RenderReport,
 ) -> Result<Simulation, SceneError> {
     let n = banks.len();
+    let t = Instant::now();
     let mut world = World::new(scene, banks)?;
+    report.colliders_s = t.elapsed().as_secs_f64();
     let dt = 1.0 / scene.physics_rate_hz;
     let steps = (scene.duration_s * scene.physics_rate_hz).ceil() as usize;
     let mut sim = Simulation {
