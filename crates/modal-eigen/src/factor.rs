@@ -231,11 +231,37 @@ impl<'a> ShiftedFactor<'a> {
     pub fn factor_ldlt(&mut self, sigma: f64) -> Result<usize, EigenError> {
         self.kind = None;
         self.fill(sigma)?;
+        let mut values = std::mem::take(&mut self.values);
+        let res = self.ldlt_into(&self.a_values, &mut values, sigma);
+        self.values = values;
+        res?;
+        self.kind = Some(Kind::Ldlt);
+        self.shift = sigma;
+        Ok(negative_pivots(&self.symbolic, &self.values))
+    }
+
+    /// Sylvester inertia at σ (eigenvalues below σ) from an LDLᵀ into private buffers,
+    /// leaving the current factor untouched, so that it can run on another thread while
+    /// this factor serves block solves. Memory: one more factor ([`Self::memory_estimate`]).
+    pub fn inertia_at(&self, sigma: f64) -> Result<usize, EigenError> {
+        let mut a = Vec::new();
+        self.pattern.values(self.k.val(), self.m.val(), sigma, &mut a);
+        let mut values = Vec::new();
+        values
+            .try_reserve_exact(self.symbolic.len_val())
+            .map_err(|_| EigenError::Factorization("out of memory for the factor".into()))?;
+        values.resize(self.symbolic.len_val(), 0.0);
+        self.ldlt_into(&a, &mut values, sigma)?;
+        Ok(negative_pivots(&self.symbolic, &values))
+    }
+
+    /// Numeric LDLᵀ of the pattern values `a` (of `K − σM`) into `values`.
+    fn ldlt_into(&self, a: &[f64], values: &mut [f64], sigma: f64) -> Result<(), EigenError> {
         let req = self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default());
         let mut buf = self.buffer(req)?;
-        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.a_values);
+        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), a);
         let res = self.symbolic.factorize_numeric_ldlt(
-            &mut self.values,
+            values,
             a,
             Side::Upper,
             LdltRegularization::default(),
@@ -244,37 +270,8 @@ impl<'a> ShiftedFactor<'a> {
             Default::default(),
         );
         match res {
-            Ok(_) => {}
-            Err(LdltError::ZeroPivot { index }) => {
-                return Err(EigenError::ZeroPivot { pivot: index, shift: sigma })
-            }
-        }
-        self.kind = Some(Kind::Ldlt);
-        self.shift = sigma;
-        Ok(self.negative_pivots())
-    }
-
-    /// Negative entries of D in the current LDLᵀ factor (NaN pivots count as negative).
-    fn negative_pivots(&self) -> usize {
-        let neg = |d: f64| d <= 0.0 || d.is_nan();
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
-                let cp = s.col_ptr();
-                (0..s.nrows()).filter(|&j| neg(self.values[cp[j]])).count()
-            }
-            SymbolicCholeskyRaw::Supernodal(s) => {
-                let f = SupernodalLdltRef::new(s, &self.values);
-                let mut count = 0;
-                for i in 0..s.n_supernodes() {
-                    let v = f.supernode(i).val();
-                    for c in 0..v.ncols() {
-                        if neg(v[(c, c)]) {
-                            count += 1;
-                        }
-                    }
-                }
-                count
-            }
+            Ok(_) => Ok(()),
+            Err(LdltError::ZeroPivot { index }) => Err(EigenError::ZeroPivot { pivot: index, shift: sigma }),
         }
     }
 
@@ -299,6 +296,30 @@ impl<'a> ShiftedFactor<'a> {
                 stack,
             ),
             None => panic!("solve_in_place called without a numeric factor"),
+        }
+    }
+}
+
+/// Negative entries of D in an LDLᵀ factor (NaN pivots count as negative).
+fn negative_pivots(symbolic: &SymbolicCholesky<usize>, values: &[f64]) -> usize {
+    let neg = |d: f64| d <= 0.0 || d.is_nan();
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let cp = s.col_ptr();
+            (0..s.nrows()).filter(|&j| neg(values[cp[j]])).count()
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let f = SupernodalLdltRef::new(s, values);
+            let mut count = 0;
+            for i in 0..s.n_supernodes() {
+                let v = f.supernode(i).val();
+                for c in 0..v.ncols() {
+                    if neg(v[(c, c)]) {
+                        count += 1;
+                    }
+                }
+            }
+            count
         }
     }
 }

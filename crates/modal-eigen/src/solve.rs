@@ -8,6 +8,13 @@
 //! `λ_scale = maxᵢ Kᵢᵢ/Mᵢᵢ` estimates the top of the spectrum; this keeps `K − σM` positive
 //! definite with condition ≲ 1e10 whatever the units, so Cholesky is used. If many modes lie
 //! below the band (ultrasonic bands), the LDLᵀ factor at `σ = λ_lo` itself is the operator.
+//!
+//! Completeness proof: Sylvester's law of inertia on an LDLᵀ of `K − σ'M` with σ' just above
+//! the highest returned mode. With [`EigenOptions::overlap_check`] this factorization starts
+//! on a second thread as soon as the Ritz values accurate to `krylov::EARLY_GATE` determine
+//! σ', overlapping the rest of the iteration (spectrum slicing: the count needs no solves).
+//! It is accepted only if σ' lies above every returned mode and the count equals the modes
+//! known below σ'; otherwise the check is factored again at the final σ'.
 
 use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation, RitzSet};
 use crate::factor::ShiftedFactor;
@@ -24,6 +31,8 @@ const MAX_BELOW_FOR_LOW_SHIFT: usize = 24;
 const LOW_EDGE_FRACTION: f64 = 1e-6;
 /// Smallest |σ| relative to the spectrum scale max Kᵢᵢ/Mᵢᵢ (condition of K − σM ≲ 1e10).
 const SHIFT_FLOOR: f64 = 1e-10;
+/// Cap on the basis columns beyond `2·nev` (see [`basis_size`]).
+const EXTRA_BASIS: usize = 100;
 /// Searches for missed modes after an inertia mismatch.
 const MAX_SEARCHES: usize = 4;
 
@@ -73,12 +82,18 @@ pub fn solve(
 
     let block = opts.block_size.min(n.saturating_sub(n_rigid).max(1));
     let nev_guess = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
-    let ncv_guess = (2 * nev_guess).max(nev_guess + 3 * block);
+    let ncv_guess = basis_size(nev_guess, block);
     stats.memory_estimate_bytes = factor.memory_estimate() + (n * (ncv_guess + 4 * block) * 8) as u64;
-    if let Some(limit) = opts.memory_limit_bytes.or_else(default_memory_limit) {
+    let limit = opts.memory_limit_bytes.or_else(default_memory_limit);
+    if let Some(limit) = limit {
         if stats.memory_estimate_bytes > limit {
             return Err(EigenError::MemoryLimit { estimated: stats.memory_estimate_bytes, limit });
         }
+    }
+    let overlap = opts.overlap_check
+        && limit.is_none_or(|l| stats.memory_estimate_bytes + factor.memory_estimate() <= l);
+    if overlap {
+        stats.memory_estimate_bytes += factor.memory_estimate();
     }
 
     // Lower inertia count and shift choice.
@@ -119,7 +134,7 @@ pub fn solve(
         searches += 1;
         let free = n - defl.len();
         let nev = wanted.min(free);
-        let ncv = (2 * nev).max(nev + 3 * block).min(free.saturating_sub(block));
+        let ncv = basis_size(nev, block).min(free.saturating_sub(block));
         let known_before = known.lambdas.clone();
         let enough = |l: &[f64]| -> bool {
             let mut all: Vec<f64> = known_before.iter().chain(l.iter()).cloned().collect();
@@ -127,8 +142,8 @@ pub fn solve(
             let in_band = all.iter().filter(|&&x| x >= lam_lo && x <= lam_hi).count();
             in_band >= cap || l.iter().any(|&x| x > lam_hi) || all.len() >= free
         };
-        let out = if ncv < nev + block || free <= 2 * block + nev {
-            dense_all(k, m, &defl)?
+        let (out, early) = if ncv < nev + block || free <= 2 * block + nev {
+            (dense_all(k, m, &defl)?, None)
         } else {
             let cfg = KsConfig {
                 nev,
@@ -139,7 +154,23 @@ pub fn solve(
                 seed: 0x5EED_0000 + searches as u64,
                 lambda_scale: lam_scale,
             };
-            search(&factor, k, m, &defl, &cfg, &enough, &mut counters, progress)?
+            let band = Band { lo: lam_lo, hi: lam_hi, cap };
+            let early_ok = overlap && searches == 1;
+            let f = &factor;
+            let (out, early) = std::thread::scope(|scope| {
+                let mut handle = None;
+                let mut early = |l: &[f64], next: f64| {
+                    if early_ok && handle.is_none() {
+                        let sig = band.early_check_shift(&known_before, l, next);
+                        handle = Some((sig, scope.spawn(move || f.inertia_at(sig))));
+                    }
+                };
+                let out = search(f, k, m, &defl, &cfg, &enough, &mut early, &mut counters, progress);
+                let early =
+                    handle.and_then(|(sig, h)| h.join().ok().and_then(Result::ok).map(|nu| (sig, nu)));
+                (out, early)
+            });
+            (out?, early)
         };
         known.merge(out.lambdas, out.vectors, m, &mut defl);
 
@@ -152,17 +183,32 @@ pub fn solve(
             .collect();
         let capped = sel.len() == cap;
         let (lams, vecs, res) = polish(k, m, &known, &sel)?;
-        let sigma_hi = upper_check_shift(&known.lambdas, &lams, capped, lam_hi);
-        stats.factorizations += 1;
-        let nu_hi = inertia(&mut factor, sigma_hi)?;
-        // Known elastic eigenvalues in [λ_lo, σ'): the returned ones plus converged ones
-        // beyond the cap (e.g. the rest of a multiplet split by `max_modes`).
-        let in_check = known.lambdas.iter().filter(|&&x| x >= lam_lo && x < sigma_hi).count();
         if !count_below {
             elastic_below = known.lambdas.iter().filter(|&&x| x < lam_lo).count();
         }
         stats.elastic_below_band = elastic_below;
-        let found = n_rigid + elastic_below + in_check.max(lams.len());
+        // Eigenvalues known below σ': rigid, below the band, and the known elastic ones in
+        // [λ_lo, σ') — the returned ones plus converged ones beyond the cap (e.g. the rest of
+        // a multiplet split by `max_modes`).
+        let found_below = |sig: f64| {
+            let in_check = known.lambdas.iter().filter(|&&x| x >= lam_lo && x < sig).count();
+            n_rigid + elastic_below + in_check.max(lams.len())
+        };
+        let top = lams.last().copied().unwrap_or(f64::NEG_INFINITY);
+        if early.is_some() {
+            stats.factorizations += 1;
+        }
+        // The early count proves completeness below its σ' if σ' lies above every returned
+        // mode and the count matches; otherwise count again at the final σ'.
+        let (sigma_hi, nu_hi) = match early {
+            Some((sig, nu)) if sig > top && nu == found_below(sig) => (sig, nu),
+            _ => {
+                let sig = upper_check_shift(&known.lambdas, &lams, capped, lam_hi);
+                stats.factorizations += 1;
+                (sig, inertia(&mut factor, sig)?)
+            }
+        };
+        let found = found_below(sigma_hi);
         stats.inertia_expected = nu_hi;
         stats.inertia_found = found;
         stats.inertia_shift = sigma_hi;
@@ -195,6 +241,15 @@ pub fn solve(
     }
 }
 
+/// Krylov basis size (columns, excluding the residual block) for `nev` wanted pairs:
+/// `nev + max(nev, min(2·nev, EXTRA_BASIS), 3·block)`. A basis of about 3·nev for up to 50
+/// modes measured 12 % fewer block solves than ARPACK's customary 2·nev (box, 30k DOF,
+/// 50 modes: 29 instead of 33) and 1–2 restarts instead of 7; beyond that the extra columns are
+/// capped so that orthogonalization and memory stay linear in nev.
+fn basis_size(nev: usize, block: usize) -> usize {
+    nev + nev.max((2 * nev).min(EXTRA_BASIS)).max(3 * block)
+}
+
 /// Re-establishes the operator factor after an inertia factorization replaced it.
 fn refactor_operator(f: &mut ShiftedFactor<'_>, sigma: f64, low: bool) -> Result<(), EigenError> {
     if low {
@@ -225,6 +280,29 @@ fn upper_check_shift(all: &[f64], returned: &[f64], capped: bool, lam_hi: f64) -
         (0.5 * (top + next)).min(bump)
     } else {
         bump
+    }
+}
+
+/// The wanted band `[lo, hi]` (λ, rad²/s²) and the mode cap.
+#[derive(Copy, Clone)]
+struct Band {
+    lo: f64,
+    hi: f64,
+    cap: usize,
+}
+
+impl Band {
+    /// σ' the final check would use if the known eigenvalues plus the accurate Ritz values
+    /// `early` (ascending, `next` the following Ritz value) were the converged ones.
+    fn early_check_shift(&self, known: &[f64], early: &[f64], next: f64) -> f64 {
+        let mut all: Vec<f64> = known.iter().chain(early).copied().collect();
+        all.sort_by(f64::total_cmp);
+        let sel: Vec<f64> =
+            all.iter().copied().filter(|&x| x >= self.lo && x <= self.hi).take(self.cap).collect();
+        if next.is_finite() {
+            all.push(next);
+        }
+        upper_check_shift(&all, &sel, sel.len() == self.cap, self.hi)
     }
 }
 

@@ -39,6 +39,12 @@ pub struct EigenOptions {
     pub memory_limit_bytes: Option<u64>,
     /// Maximum number of Krylov–Schur restarts per search. Default 200.
     pub max_restarts: usize,
+    /// Start the upper inertia check (an LDLᵀ of `K − σ'M`) on a second thread as soon as the
+    /// Ritz values fix σ', overlapping it with the rest of the iteration; needs one more factor
+    /// in memory (skipped if that exceeds the memory limit). The proof is unchanged: if the
+    /// early σ' does not fit the converged modes, the check is redone at the final σ'.
+    /// Default true.
+    pub overlap_check: bool,
 }
 
 impl Default for EigenOptions {
@@ -53,6 +59,7 @@ impl Default for EigenOptions {
             threads: 1,
             memory_limit_bytes: None,
             max_restarts: 200,
+            overlap_check: true,
         }
     }
 }
