@@ -8,6 +8,12 @@
 //! contact time and a sub-step onset time. Output: audio channels (mono or
 //! stereo) heard at a listener with 1/r attenuation and r/c delay, a
 //! [`RenderReport`], optional impact events (JSON) and a spectrogram (PNG).
+//!
+//! Dynamic bodies collide through a reduced convex hull or, per object, a
+//! convex decomposition (module `collider`); a rolling-resistance couple
+//! lets them come to rest and sleep, after which the physics stops (module
+//! `physics`); the ground is a silent plane or a sounding slab whose bank
+//! comes from the same provider (module `ground`).
 
 mod collider;
 mod error;
@@ -23,7 +29,7 @@ mod spec;
 pub mod stand_in;
 mod validate;
 
-pub use collider::{DECOMPOSITION_CONCAVITY, DECOMPOSITION_RESOLUTION};
+pub use collider::{DECOMPOSITION_CONCAVITY, DECOMPOSITION_RESOLUTION, MAX_HULL_VERTICES};
 pub use error::SceneError;
 pub use excite::{
     hertz_contact_time, ImpactEvent, Strike, MAX_CONTACT_TIME_S, MIN_APPROACH_CONTINUING_M_S,
@@ -36,7 +42,7 @@ pub use modal_synth::WavFormat;
 pub use output::{
     write_events_json, write_spectrogram_png, write_wav, SPECTROGRAM_RANGE_DB, SPECTROGRAM_WINDOW,
 };
-pub use physics::ContactSide;
+pub use physics::{ContactSide, ROLLING_LOAD_CAP, SLEEP_AFTER_S};
 pub use provider::{BankProvider, BankRequest, InMemoryProvider, ProviderError};
 pub use render::{
     render, ObjectReport, RenderOptions, RenderReport, Rendered, AIR_IMPEDANCE_PA_S_M, FADE_OUT_S,
