@@ -64,7 +64,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
 }
 
 fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
-    let h = args.h.unwrap_or_else(|| default_element_size(&shape));
+    let h = args.h.unwrap_or_else(|| shape.default_element_size(args.order));
     let mesh = modal_mesh::generate::generate(&shape, h, args.order)?;
     write_mesh(&args.out, &mesh)?;
     let summary = serde_json::json!({
@@ -95,21 +95,4 @@ fn write_mesh(path: &std::path::Path, mesh: &TetMesh) -> Result<()> {
         Ok(())
     })
     .with_context(|| format!("cannot write {}", path.display()))
-}
-
-/// A fifth of the smallest dimension: a coarse but usable default.
-fn default_element_size(shape: &Shape) -> f64 {
-    let smallest = match *shape {
-        Shape::Box { size } => size.iter().copied().fold(f64::INFINITY, f64::min),
-        Shape::Cylinder { radius, length } => (2.0 * radius).min(length),
-        Shape::Tube { inner_radius, outer_radius, length } => (outer_radius - inner_radius).min(length) * 2.0,
-        Shape::Sphere { radius } => 2.0 * radius,
-        Shape::Bowl { thickness, .. } => 2.0 * thickness,
-    };
-    // Invalid dimensions get any valid size: the generator then names them.
-    if smallest.is_finite() && smallest > 0.0 {
-        smallest / 5.0
-    } else {
-        1.0
-    }
 }

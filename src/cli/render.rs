@@ -18,9 +18,6 @@ use super::progress::Spinner;
 
 /// Where the demo is written when no output is given.
 pub const DEMO_OUTPUT: &str = "audio_out/demo.wav";
-/// Element size of generated meshes without `element_size`: this fraction of
-/// the shape's smallest dimension.
-const DEFAULT_ELEMENTS_PER_SMALLEST_DIMENSION: f64 = 3.0;
 
 /// Serves scene objects' banks through the precompute pipeline and its cache.
 struct PipelineProvider<'a> {
@@ -45,11 +42,10 @@ impl BankProvider for PipelineProvider<'_> {
             modal_scene::MeshSource::File(path) => MeshSource::File(path.clone()),
             modal_scene::MeshSource::Generate(spec) => {
                 let shape = spec.shape()?;
-                let h = spec
-                    .element_size
-                    .unwrap_or_else(|| smallest_dimension(&shape) / DEFAULT_ELEMENTS_PER_SMALLEST_DIMENSION);
-                // Linear here; the pipeline promotes to the requested order.
-                let mesh = modal_mesh::generate::generate(&shape, h, 1)?;
+                let order = request.order.unwrap_or(2);
+                let h = spec.element_size.unwrap_or_else(|| shape.default_element_size(order));
+                // At the requested order, so curved shapes get curved (P2) boundaries.
+                let mesh = modal_mesh::generate::generate(&shape, h, order)?;
                 MeshSource::Memory { mesh, identity: format!("generated {shape:?} h={h:e}") }
             }
         };
@@ -77,17 +73,6 @@ fn describe(mesh: &modal_scene::MeshSource) -> String {
     match mesh {
         modal_scene::MeshSource::File(path) => path.display().to_string(),
         modal_scene::MeshSource::Generate(spec) => format!("generated {}", spec.generate),
-    }
-}
-
-fn smallest_dimension(shape: &modal_mesh::generate::Shape) -> f64 {
-    use modal_mesh::generate::Shape;
-    match *shape {
-        Shape::Box { size } => size.iter().copied().fold(f64::INFINITY, f64::min),
-        Shape::Cylinder { radius, length } => (2.0 * radius).min(length),
-        Shape::Tube { inner_radius, outer_radius, length } => (outer_radius - inner_radius).min(length),
-        Shape::Sphere { radius } => 2.0 * radius,
-        Shape::Bowl { thickness, .. } => thickness,
     }
 }
 
