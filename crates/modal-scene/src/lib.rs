@@ -53,4 +53,4 @@ pub use spec::{
     MaterialSpec, MeshSource, ObjectSpec, RotationSpec, Scene, AUTO_DECOMPOSITION_RATIO,
     DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
 };
-pub use validate::{MAX_DURATION_S, MAX_OBJECTS};
+pub use validate::{MAX_DURATION_S, MAX_OBJECTS, MAX_SLAB_CELLS};

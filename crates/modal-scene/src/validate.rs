@@ -7,6 +7,9 @@ use crate::SceneError;
 
 /// Longest scene accepted [s] (guards against giant allocations).
 pub const MAX_DURATION_S: f64 = 3600.0;
+/// Most mesh cells (element-size cubes) of a sounding ground slab: guards the
+/// bank provider against a giant mesh.
+pub const MAX_SLAB_CELLS: f64 = 1e6;
 /// Most objects accepted in one scene.
 pub const MAX_OBJECTS: usize = 100_000;
 
@@ -52,6 +55,17 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
         finite("ground.center[1]", g.center_m[1])?;
         if let Some(h) = g.element_size_m {
             positive("ground.element_size", h)?;
+        }
+        if let Some(size) = g.size_m {
+            let h = g.element_size_m.unwrap_or(g.thickness_m);
+            let cells =
+                [size[0], size[1], g.thickness_m].iter().map(|l| (l / h).ceil().max(1.0)).product::<f64>();
+            if cells > MAX_SLAB_CELLS {
+                return Err(SceneError::invalid(
+                    "ground.size",
+                    format!("the slab would need ≈ {cells:.0} mesh cells (at most {MAX_SLAB_CELLS:.0}); raise ground.element_size"),
+                ));
+            }
         }
     }
     if scene.objects.len() > MAX_OBJECTS {

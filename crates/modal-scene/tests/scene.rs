@@ -126,6 +126,9 @@ fn bad_scenes_name_the_offending_field() {
         (obj(""), "objects[0].material"),
         ("sample_rate = 100\n".to_string(), "sample_rate"),
         ("[listener]\nposition = [0.0, 1.0]\n".to_string(), "listener.position"),
+        ("[ground]\nsize = [1e6, 1e6]\n".to_string(), "ground.size"),
+        ("[ground]\nsize = [1.0, -1.0]\n".to_string(), "ground.size[1]"),
+        (obj("material = \"steel\"\ncollider = \"mesh\""), "objects[0].collider"),
     ];
     for (text, path) in cases {
         let e = error_of(&text, dir.path());
