@@ -148,12 +148,13 @@ fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, s
         );
     }
     println!(
-        "banks: {} distinct ({} from cache, {} solved) in {:.2} s; physics {:.3} s ({} steps), excitation {:.3} s, \
-         synthesis {:.3} s, mix {:.3} s: {:.0}x real time",
+        "banks: {} distinct ({} from cache, {} solved) in {:.2} s; colliders {:.3} s, physics {:.3} s ({} steps), \
+         excitation {:.3} s, synthesis {:.3} s, mix {:.3} s: {:.0}x real time",
         report.banks_requested,
         cached,
         solved,
         report.banks_s,
+        report.colliders_s,
         report.physics_s,
         report.physics_steps,
         report.excitation_s,
