@@ -126,9 +126,9 @@ pub struct RenderReport {
 }
 
 impl RenderReport {
-    /// Audio seconds per wall-clock second of the per-render work: colliders
-    /// + physics + excitation + synthesis + mix (bank loading or solving is
-    /// reported separately in `banks_s`).
+    /// Audio seconds per wall-clock second of the per-render work: collider
+    /// set-up, physics, excitation, synthesis and mix (bank loading or
+    /// solving is reported separately in `banks_s`).
     pub fn real_time_factor(&self) -> f64 {
         let wall = self.colliders_s + self.physics_s + self.excitation_s + self.synthesis_s + self.mix_s;
         if wall > 0.0 {
