@@ -235,3 +235,21 @@ fn default_element_size_keeps_bar_and_sphere_within_one_percent() {
         assert!(rel(*got, want) < 0.01, "sphere at the default size, mode {}: {got:.1} vs {want:.1}", i + 1);
     }
 }
+
+/// Heavy variant (`cargo test -p modal-precompute --release --test stress -- --ignored`):
+/// a finer curved sphere across ν, with a bound four times tighter.
+#[test]
+#[ignore = "heavy: ≈ 22k-DOF solves; run by hand in release"]
+fn fine_sphere_poisson_sweep_within_a_quarter_percent() {
+    let radius = 0.05;
+    let fine = sphere(radius, 0.014, 2).unwrap();
+    for (nu, s2_eta) in [(0.0, 2.5920), (0.3, 2.6462), (0.49, 2.6648)] {
+        let f = run(fine.clone(), material(nu, RHO), 10, 80_000.0).bank.frequencies_hz;
+        let (t2, s2) = (lamb_hz(2.5011, nu, radius), lamb_hz(s2_eta, nu, radius));
+        for (i, got) in f.iter().enumerate() {
+            let want = if i < 5 { t2 } else { s2 };
+            eprintln!("nu {nu} mode {} err {:.2e}", i + 1, rel(*got, want));
+            assert!(rel(*got, want) < 0.0025, "ν {nu}, mode {}: {got:.1} Hz vs Lamb {want:.1} Hz", i + 1);
+        }
+    }
+}
