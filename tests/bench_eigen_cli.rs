@@ -5,26 +5,13 @@
 mod common;
 use common::*;
 use std::path::Path;
-use std::process::Command;
 
 /// Runs `modal bench eigen ARGS` with TMPDIR inside `dir`.
 fn bench(dir: &Path, args: &[&str]) -> Run {
     let tmp = dir.join("tmp");
     std::fs::create_dir_all(&tmp).unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_modal"))
-        .args(["bench", "eigen"])
-        .args(args)
-        .current_dir(dir)
-        .env("TMPDIR", &tmp)
-        .env("MODAL_CACHE_DIR", dir.join("cache"))
-        .output()
-        .expect("the modal binary runs");
-    Run {
-        success: output.status.success(),
-        code: output.status.code(),
-        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
-    }
+    let args: Vec<&str> = ["bench", "eigen"].into_iter().chain(args.iter().copied()).collect();
+    modal_with_env(dir, &args, &[("TMPDIR", &tmp)])
 }
 
 #[test]

@@ -14,10 +14,16 @@ pub struct Run {
 
 /// Runs `modal ARGS` in `dir` with a private cache directory.
 pub fn modal(dir: &Path, args: &[&str]) -> Run {
+    modal_with_env(dir, args, &[])
+}
+
+/// [`modal`] with extra environment variables.
+pub fn modal_with_env(dir: &Path, args: &[&str], env: &[(&str, &Path)]) -> Run {
     let output = Command::new(env!("CARGO_BIN_EXE_modal"))
         .args(args)
         .current_dir(dir)
         .env("MODAL_CACHE_DIR", dir.join("cache"))
+        .envs(env.iter().copied())
         .output()
         .expect("the modal binary runs");
     Run {
