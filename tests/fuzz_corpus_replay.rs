@@ -96,7 +96,13 @@ fn corpus_and_mutants_never_panic() {
             // entries per target (named by their SHA-1) and large seeds fewer,
             // so the test stays quick in debug builds.
             let minimized = entry.file_name().is_some_and(|n| n.len() == 40);
-            let mutants = if seed.len() > 10_000 { 50 } else if minimized { 40 } else { 1000 };
+            let mutants = if seed.len() > 10_000 {
+                50
+            } else if minimized {
+                40
+            } else {
+                1000
+            };
             let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ ((k as u64 + 1) * 7919));
             for _ in 0..mutants {
                 run_target(&target, &mutate(&seed, &mut rng));
@@ -104,5 +110,8 @@ fn corpus_and_mutants_never_panic() {
             replayed += 1;
         }
     }
-    assert!(replayed >= 8 * 49, "every target has its seeds and minimized corpus ({replayed} entries replayed)");
+    assert!(
+        replayed >= 8 * 49,
+        "every target has its seeds and minimized corpus ({replayed} entries replayed)"
+    );
 }
