@@ -45,20 +45,8 @@ fn a_sounding_ground_rings_at_its_bank_frequencies() {
     assert!((first.time_s - (2.0 * 0.1 / 9.81f64).sqrt()).abs() < 2e-3, "{first:?}");
     assert!(first.point_m[1].abs() < 2e-3, "{first:?}");
 
-    let y = &out.channels[0];
-    let n = 4096;
-    let start = common::onset(y, 1e-2).expect("sound");
-    let spec = common::spectrum(&y[start..start + n]);
-    let bin = 16000.0 / n as f64;
-    let level = |f: f64| {
-        let k = (f / bin).round() as usize;
-        spec[k - 2..=k + 2].iter().cloned().fold(0.0, f64::max)
-    };
-    let floor = {
-        let mut s = spec.clone();
-        s.sort_by(f64::total_cmp);
-        s[s.len() / 2]
-    };
+    let spectrum = common::Spectrum::after_onset(&out.channels[0], 4096, 16000.0);
+    let (level, floor) = (|f| spectrum.level(f), spectrum.median());
     // The slab's two modes (wood damps fast, so they stay low) and the ball's.
     for f in [500.0, 800.0, 3100.0] {
         assert!(level(f) > 100.0 * floor, "no spectral peak at {f} Hz: {} vs median {floor}", level(f));

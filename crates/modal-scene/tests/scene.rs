@@ -40,20 +40,8 @@ fn both_bodies_of_a_contact_ring_at_their_own_frequencies() {
     let scene = Scene::from_toml_str(BALL_ON_SLAB, Path::new(".")).expect("scene");
     let out = render(&scene, &mut slab_provider(), &RenderOptions::default()).expect("render");
     assert!(out.report.objects.iter().all(|o| o.impacts >= 1), "{:?}", out.report.objects);
-    let y = &out.channels[0];
-    let n = 8192;
-    let start = common::onset(y, 1e-2).expect("sound");
-    let spec = common::spectrum(&y[start..start + n]);
-    let bin = 16000.0 / n as f64;
-    let level = |f: f64| {
-        let k = (f / bin).round() as usize;
-        spec[k - 2..=k + 2].iter().cloned().fold(0.0, f64::max)
-    };
-    let floor = {
-        let mut s = spec.clone();
-        s.sort_by(f64::total_cmp);
-        s[s.len() / 2]
-    };
+    let spectrum = common::Spectrum::after_onset(&out.channels[0], 8192, 16000.0);
+    let (level, floor) = (|f| spectrum.level(f), spectrum.median());
     // The slab's 2300 Hz mode decays within ~20 ms (wood, β ω²/2 ≈ 210/s):
     // check each body's lowest mode and the ball's second.
     for f in [700.0, 1500.0, 3100.0] {

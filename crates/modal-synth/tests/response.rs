@@ -3,7 +3,6 @@
 mod common;
 use common::*;
 use modal_synth::*;
-use realfft::RealFftPlanner;
 
 const FREQS: [f64; 5] = [440.0, 1000.0, 2500.0, 4100.0, 7300.0];
 const DECAYS: [f64; 5] = [3.0, 8.0, 20.0, 35.0, 60.0];
@@ -33,19 +32,11 @@ fn spectrum_peaks_at_damped_frequencies() {
     let b = bank(&FREQS, &DECAYS);
     let rate = 48_000.0;
     let (mut y, _) = strike(&b, rate, 0.0, J, 1.0);
-    let n = y.len();
-    for (k, x) in y.iter_mut().enumerate() {
-        *x *= (0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos()) as f32;
-    }
-    let fft = RealFftPlanner::<f32>::new().plan_fft_forward(n);
-    let mut spec = fft.make_output_vec();
-    fft.process(&mut y, &mut spec).unwrap();
-    let bin = rate / n as f64;
+    let bin = rate / y.len() as f64;
+    let spec = hann_spectrum(&mut y);
     for (i, f) in FREQS.iter().enumerate() {
         let fd = f * (1.0 - b.damping_ratios[i].powi(2)).sqrt();
-        let centre = (fd / bin).round() as usize;
-        let best =
-            (centre - 20..=centre + 20).max_by(|&a, &c| spec[a].norm().total_cmp(&spec[c].norm())).unwrap();
+        let best = peak_bin_near(&spec, fd / bin);
         assert!(
             (best as f64 - fd / bin).abs() <= 1.0,
             "mode {i}: peak at {} Hz, expected {fd} Hz",

@@ -8,7 +8,6 @@
 mod common;
 use common::*;
 use modal_synth::*;
-use realfft::RealFftPlanner;
 
 const AT: [f64; 3] = [0.3, 0.02, 0.004];
 const J: [f64; 3] = [0.0, -0.004, 0.01];
@@ -141,20 +140,11 @@ fn sample_rates_8k_to_192k_peaks_within_a_bin_and_band_limit_reported() {
         let strike = Strike { time_s: 0.0, at: AT, impulse_ns: J, contact_time_s: 0.0 };
         let (mut y, e) = render_vs_closed_form(&b, &[strike], &o, 1.0);
         assert!(e.max_rel < 1e-5, "{rate} Hz: {e:?}");
-        let n = y.len();
-        for (k, x) in y.iter_mut().enumerate() {
-            *x *= (0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos()) as f32;
-        }
-        let fft = RealFftPlanner::<f32>::new().plan_fft_forward(n);
-        let mut spec = fft.make_output_vec();
-        fft.process(&mut y, &mut spec).unwrap();
-        let bin = rate / n as f64;
+        let bin = rate / y.len() as f64;
+        let spec = hann_spectrum(&mut y);
         for (i, f) in freqs[..3].iter().enumerate() {
             let fd = f * (1.0 - b.damping_ratios[i].powi(2)).sqrt();
-            let c = (fd / bin).round() as usize;
-            let best = (c - 20..=(c + 20).min(spec.len() - 1))
-                .max_by(|&a, &d| spec[a].norm().total_cmp(&spec[d].norm()))
-                .unwrap();
+            let best = peak_bin_near(&spec, fd / bin);
             assert!(
                 (best as f64 - fd / bin).abs() <= 1.0,
                 "{rate} Hz, mode {i}: peak bin {best}, want {fd} Hz"

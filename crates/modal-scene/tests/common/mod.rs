@@ -54,3 +54,31 @@ pub fn spectrum(x: &[f32]) -> Vec<f64> {
     fft.process(&mut input, &mut out).expect("fft");
     out.iter().map(|c| c.norm()).collect()
 }
+
+/// Hann-windowed magnitude spectrum of `n` samples from the onset of `y`
+/// (first sample above 1 % of the peak), for checking which modes ring.
+pub struct Spectrum {
+    magnitudes: Vec<f64>,
+    bin_hz: f64,
+}
+
+impl Spectrum {
+    /// The spectrum of `y[onset .. onset + n]` at `sample_rate` (Hz).
+    pub fn after_onset(y: &[f32], n: usize, sample_rate: f64) -> Self {
+        let start = onset(y, 1e-2).expect("sound");
+        Spectrum { magnitudes: spectrum(&y[start..start + n]), bin_hz: sample_rate / n as f64 }
+    }
+
+    /// Largest magnitude within ±2 bins of `f` (Hz).
+    pub fn level(&self, f: f64) -> f64 {
+        let k = (f / self.bin_hz).round() as usize;
+        self.magnitudes[k - 2..=k + 2].iter().cloned().fold(0.0, f64::max)
+    }
+
+    /// Median magnitude: the noise floor the peaks are compared with.
+    pub fn median(&self) -> f64 {
+        let mut s = self.magnitudes.clone();
+        s.sort_by(f64::total_cmp);
+        s[s.len() / 2]
+    }
+}

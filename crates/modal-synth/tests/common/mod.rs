@@ -126,3 +126,23 @@ pub fn max_diff(a: &[f32], b: &[f32]) -> f64 {
     assert_eq!(a.len(), b.len());
     a.iter().zip(b).fold(0.0f64, |m, (&x, &y)| m.max((x as f64 - y as f64).abs()))
 }
+
+/// Hann-windowed spectrum of `y` (windowed in place), bin k at k·fs/len.
+pub fn hann_spectrum(y: &mut [f32]) -> Vec<realfft::num_complex::Complex<f32>> {
+    let n = y.len();
+    for (k, x) in y.iter_mut().enumerate() {
+        *x *= (0.5 - 0.5 * (2.0 * PI * k as f64 / n as f64).cos()) as f32;
+    }
+    let fft = realfft::RealFftPlanner::<f32>::new().plan_fft_forward(n);
+    let mut spec = fft.make_output_vec();
+    fft.process(y, &mut spec).unwrap();
+    spec
+}
+
+/// The loudest bin within ±20 bins of fractional bin `target`.
+pub fn peak_bin_near(spec: &[realfft::num_complex::Complex<f32>], target: f64) -> usize {
+    let centre = target.round() as usize;
+    (centre.saturating_sub(20)..=(centre + 20).min(spec.len() - 1))
+        .max_by(|&a, &b| spec[a].norm().total_cmp(&spec[b].norm()))
+        .unwrap()
+}
