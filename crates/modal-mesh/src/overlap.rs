@@ -20,27 +20,27 @@ const FACES: [([usize; 3], usize); 4] = [([1, 2, 3], 0), ([0, 2, 3], 1), ([0, 1,
 /// Errors naming two overlapping elements; `mesh` must be positively
 /// oriented and free of degenerate tets.
 pub(crate) fn check_overlaps(mesh: &TetMesh) -> Result<(), MeshError> {
-    // face (sorted node ids) → (first element, its opposite corner node)
-    let mut faces: HashMap<[usize; 3], (usize, usize)> = HashMap::with_capacity(2 * mesh.cells.len());
-    let mut seen_twice: HashMap<[usize; 3], usize> = HashMap::new();
+    // face (sorted node ids) → (first element, its opposite corner, second element)
+    let mut faces: HashMap<[usize; 3], (usize, usize, Option<usize>)> =
+        HashMap::with_capacity(2 * mesh.cells.len());
     for element in 0..mesh.cells.len() {
         let corners = mesh.cells.corners(element);
         for (face, opposite) in FACES {
             let mut key = face.map(|k| corners[k]);
             key.sort_unstable();
             let apex = corners[opposite];
-            match faces.get(&key) {
+            match faces.get_mut(&key) {
                 None => {
-                    faces.insert(key, (element, apex));
+                    faces.insert(key, (element, apex, None));
                 }
-                Some(&(first, first_apex)) => {
-                    if let Some(&second) = seen_twice.get(&key) {
-                        return Err(MeshError::OverlappingTets { element, first, second });
+                Some((first, _, Some(second))) => {
+                    return Err(MeshError::OverlappingTets { element, first: *first, second: *second });
+                }
+                Some((first, first_apex, second)) => {
+                    if same_side(&mesh.nodes, key, apex, *first_apex) {
+                        return Err(MeshError::FoldedTets { element, first: *first });
                     }
-                    if same_side(&mesh.nodes, key, apex, first_apex) {
-                        return Err(MeshError::FoldedTets { element, first });
-                    }
-                    seen_twice.insert(key, element);
+                    *second = Some(element);
                 }
             }
         }
