@@ -107,21 +107,101 @@ fn reduced_hull(points: &[Vector]) -> Option<SharedShape> {
 /// The points of `points` extreme along `k` directions spread evenly over
 /// the sphere (a Fibonacci lattice): each is a vertex of the full hull, and
 /// their hull lies inside the full one, closer the more directions
-/// (deterministic).
+/// (deterministic). Along each direction the winner is the point with the
+/// largest `p·d` in `f32` (ordered as `f32::total_cmp`), the last such point
+/// on ties.
 fn extreme_points(points: &[Vector], k: usize) -> Vec<Vector> {
+    if points.is_empty() {
+        return Vec::new();
+    }
     let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    let mut chosen: Vec<usize> = (0..k)
-        .filter_map(|i| {
+    let directions: Vec<Vector> = (0..k)
+        .map(|i| {
             let y = 1.0 - 2.0 * (i as f32 + 0.5) / k as f32;
             let r = (1.0 - y * y).max(0.0).sqrt();
             let (s, c) = (golden * i as f32).sin_cos();
-            let d = Vector::new(r * c, y, r * s);
-            points.iter().map(|p| p.dot(d)).enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).map(|(j, _)| j)
+            Vector::new(r * c, y, r * s)
         })
         .collect();
+    let cloud = Cloud::new(points);
+    let mut chosen: Vec<usize> = Vec::with_capacity(k);
+    for block in directions.chunks(SCAN_LANES) {
+        chosen.extend(&cloud.argmax(block)[..block.len()]);
+    }
     chosen.sort_unstable();
     chosen.dedup();
     chosen.into_iter().map(|j| points[j]).collect()
+}
+
+/// Directions scanned together in one pass over the points.
+const SCAN_LANES: usize = 8;
+
+/// Points as structure of arrays, for [`Cloud::argmax`].
+struct Cloud {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl Cloud {
+    fn new(points: &[Vector]) -> Cloud {
+        Cloud {
+            x: points.iter().map(|p| p.x).collect(),
+            y: points.iter().map(|p| p.y).collect(),
+            z: points.iter().map(|p| p.z).collect(),
+        }
+    }
+
+    /// Index of the point with the largest `p·d` for each of up to
+    /// [`SCAN_LANES`] directions (unused lanes hold garbage): one pass over
+    /// the points, a branch-free compare-and-select per lane. The dot product
+    /// is evaluated as glam's `Vec3::dot`, `(x·dx + y·dy) + z·dz`, so the
+    /// result equals a per-direction `max_by(total_cmp)` exactly.
+    fn argmax(&self, directions: &[Vector]) -> [usize; SCAN_LANES] {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.argmax_avx2(directions) };
+        }
+        self.argmax_lanes(directions)
+    }
+
+    /// [`Cloud::argmax`] compiled for AVX2 (no FMA: the products round as in
+    /// the portable path).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn argmax_avx2(&self, directions: &[Vector]) -> [usize; SCAN_LANES] {
+        self.argmax_lanes(directions)
+    }
+
+    #[inline(always)]
+    fn argmax_lanes(&self, directions: &[Vector]) -> [usize; SCAN_LANES] {
+        let (mut dx, mut dy, mut dz) = ([0.0f32; SCAN_LANES], [0.0f32; SCAN_LANES], [0.0f32; SCAN_LANES]);
+        for (l, d) in directions.iter().take(SCAN_LANES).enumerate() {
+            (dx[l], dy[l], dz[l]) = (d.x, d.y, d.z);
+        }
+        let mut best = [i32::MIN; SCAN_LANES];
+        let mut index = [0u32; SCAN_LANES];
+        let n = self.x.len().min(self.y.len()).min(self.z.len());
+        let (xs, ys, zs) = (&self.x[..n], &self.y[..n], &self.z[..n]);
+        for j in 0..n {
+            let (x, y, z) = (xs[j], ys[j], zs[j]);
+            for l in 0..SCAN_LANES {
+                let key = total_order_key((x * dx[l]) + (y * dy[l]) + (z * dz[l]));
+                let take = key >= best[l];
+                best[l] = if take { key } else { best[l] };
+                index[l] = if take { j as u32 } else { index[l] };
+            }
+        }
+        index.map(|i| i as usize)
+    }
+}
+
+/// An integer that orders like `f32::total_cmp` orders the float.
+#[inline(always)]
+fn total_order_key(v: f32) -> i32 {
+    let bits = v.to_bits() as i32;
+    bits ^ (((bits >> 31) as u32) >> 1) as i32
 }
 
 fn decomposition(bank: &ModeBank, points: &[Vector], path: &str) -> Result<SharedShape, SceneError> {
@@ -178,6 +258,55 @@ mod tests {
         let few = sphere_points(100);
         let exact = reduced_hull(&few).expect("hull");
         assert_eq!(exact.as_convex_polyhedron().expect("polyhedron").points().len(), 100);
+    }
+
+    /// The plain per-direction scan [`extreme_points`] must reproduce.
+    fn extreme_points_reference(points: &[Vector], k: usize) -> Vec<Vector> {
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let mut chosen: Vec<usize> = (0..k)
+            .filter_map(|i| {
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / k as f32;
+                let r = (1.0 - y * y).max(0.0).sqrt();
+                let (s, c) = (golden * i as f32).sin_cos();
+                let d = Vector::new(r * c, y, r * s);
+                points.iter().map(|p| p.dot(d)).enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).map(|(j, _)| j)
+            })
+            .collect();
+        chosen.sort_unstable();
+        chosen.dedup();
+        chosen.into_iter().map(|j| points[j]).collect()
+    }
+
+    #[test]
+    fn extreme_points_equal_the_per_direction_scan() {
+        // A noisy cloud with exact duplicates (ties go to the last index),
+        // and direction counts that leave partly filled lane blocks.
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let mut points: Vec<Vector> = (0..2000).map(|_| Vector::new(rnd(), 0.3 * rnd(), rnd())).collect();
+        points.extend_from_within(..500);
+        points.push(Vector::new(-0.0, 0.0, 0.0));
+        for k in [1, 7, 8, 61, 384] {
+            assert_eq!(extreme_points(&points, k), extreme_points_reference(&points, k), "k = {k}");
+        }
+        assert_eq!(
+            extreme_points(&sphere_points(3000), 384),
+            extreme_points_reference(&sphere_points(3000), 384)
+        );
+        assert!(extreme_points(&[], 8).is_empty());
+    }
+
+    #[test]
+    fn total_order_key_orders_like_total_cmp() {
+        let values = [f32::NEG_INFINITY, -1.5, -0.0, 0.0, 1e-30, 2.0, f32::INFINITY];
+        for a in values {
+            for b in values {
+                assert_eq!(total_order_key(a).cmp(&total_order_key(b)), a.total_cmp(&b), "{a} vs {b}");
+            }
+        }
     }
 
     #[test]
