@@ -348,7 +348,7 @@ fn shared_models(
         let idx = match models.iter().position(|m| m.0 == key) {
             Some(idx) => idx,
             None => {
-                let model = SynthModel::new(bank).map_err(|e| SceneError::Synthesis {
+                let model = SynthModel::shared(Arc::clone(bank)).map_err(|e| SceneError::Synthesis {
                     object: names[i].clone(),
                     message: e.to_string(),
                 })?;

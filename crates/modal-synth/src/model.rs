@@ -6,6 +6,8 @@
 //! velocity `a_i = φ_i(p)·j` [√kg·m/s] and the surface displacement at `x` is
 //! `u(x, t) = Σ_i φ_i(x) q_i(t)` \[m\].
 
+use std::sync::Arc;
+
 use crate::error::SynthError;
 use crate::surface::{node_weights, SurfaceLocator, SurfacePoint};
 use modal_bank::ModeBank;
@@ -15,7 +17,8 @@ use modal_mesh::Surface;
 /// fraction of the bounding-box diagonal.
 pub const MAX_SNAP_FRACTION: f64 = 0.1;
 
-/// Per-mode data and the surface of one bank, validated.
+/// Per-mode data and the surface of one bank, validated. The shapes and the
+/// surface are read from the bank itself, shared, never copied.
 #[derive(Clone, Debug)]
 pub struct SynthModel {
     /// Undamped natural frequencies \[Hz\].
@@ -24,59 +27,27 @@ pub struct SynthModel {
     pub decay_rates: Vec<f64>,
     /// Damping ratios ξ [-].
     pub damping_ratios: Vec<f64>,
-    shapes: Vec<f32>,
-    surface: Surface,
+    bank: Arc<ModeBank>,
     locator: SurfaceLocator,
 }
 
 impl SynthModel {
-    /// Copies and checks what the synthesizer needs from `bank`.
+    /// Copies and checks what the synthesizer needs from `bank` (the whole
+    /// bank is cloned; [`SynthModel::shared`] avoids the copy).
     pub fn new(bank: &ModeBank) -> Result<SynthModel, SynthError> {
-        let n = bank.frequencies_hz.len();
-        let nodes = bank.surface.positions.len();
-        let bad = |m: String| Err(SynthError::InconsistentBank(m));
-        if bank.decay_rates.len() != n || bank.damping_ratios.len() != n {
-            return bad(format!(
-                "{n} frequencies but {} decay rates and {} damping ratios",
-                bank.decay_rates.len(),
-                bank.damping_ratios.len()
-            ));
-        }
-        if Some(bank.shapes.len()) != n.checked_mul(nodes).and_then(|x| x.checked_mul(3)) {
-            return bad(format!(
-                "{} shape values, expected {n} modes × {nodes} nodes × 3",
-                bank.shapes.len()
-            ));
-        }
-        if let Some(k) = bank.shapes.iter().position(|x| !x.is_finite()) {
-            let (mode, node) = (k / 3 / nodes.max(1), k / 3 % nodes.max(1));
-            return bad(format!("mode {mode} has a non-finite shape value at surface node {node}"));
-        }
-        if let Some(k) = bank.surface.positions.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
-            return bad(format!("surface node {k} has a non-finite position"));
-        }
-        if let Some(t) = bank.surface.triangles.iter().position(|t| t.iter().any(|&k| k >= nodes)) {
-            return bad(format!("surface triangle {t} refers to a node >= {nodes}"));
-        }
-        if let Some(e) = &bank.surface.triangle_edge_nodes {
-            if e.len() != bank.surface.triangles.len() {
-                return bad(format!(
-                    "{} triangles but {} mid-edge triples",
-                    bank.surface.triangles.len(),
-                    e.len()
-                ));
-            }
-            if let Some(t) = e.iter().position(|t| t.iter().any(|&k| k >= nodes)) {
-                return bad(format!("mid-edge nodes of surface triangle {t} refer to a node >= {nodes}"));
-            }
-        }
+        SynthModel::shared(Arc::new(bank.clone()))
+    }
+
+    /// Checks `bank` and keeps a reference to it (its shapes and surface are
+    /// used in place).
+    pub fn shared(bank: Arc<ModeBank>) -> Result<SynthModel, SynthError> {
+        check(&bank)?;
         Ok(SynthModel {
             frequencies_hz: bank.frequencies_hz.clone(),
             decay_rates: bank.decay_rates.clone(),
             damping_ratios: bank.damping_ratios.clone(),
-            shapes: bank.shapes.clone(),
-            surface: bank.surface.clone(),
             locator: SurfaceLocator::new(&bank.surface),
+            bank,
         })
     }
 
@@ -87,7 +58,7 @@ impl SynthModel {
 
     /// The surface.
     pub fn surface(&self) -> &Surface {
-        &self.surface
+        &self.bank.surface
     }
 
     /// Nearest surface point to `p` \[m\]. Errors when `p` is not finite, the
@@ -97,7 +68,7 @@ impl SynthModel {
         if !p.iter().all(|x| x.is_finite()) {
             return Err(SynthError::InvalidPoint(p));
         }
-        let hit = self.locator.nearest(&self.surface, p).ok_or(SynthError::EmptySurface)?;
+        let hit = self.locator.nearest(self.surface(), p).ok_or(SynthError::EmptySurface)?;
         let limit = MAX_SNAP_FRACTION * self.locator.bbox_diagonal();
         if hit.distance > limit {
             return Err(SynthError::PointFarFromSurface { point: p, distance: hit.distance, limit });
@@ -109,13 +80,13 @@ impl SynthModel {
     /// `out.len()` must equal `mode_count()`.
     pub fn shapes_dot(&self, p: &SurfacePoint, v: [f64; 3], out: &mut [f64]) {
         assert_eq!(out.len(), self.mode_count(), "shapes_dot: output length");
-        let w = node_weights(&self.surface, p);
-        let nodes = self.surface.positions.len();
+        let w = node_weights(self.surface(), p);
+        let nodes = self.surface().positions.len();
         for (i, o) in out.iter_mut().enumerate() {
             let mut acc = 0.0;
             for k in 0..w.len {
                 let b = (i * nodes + w.nodes[k]) * 3;
-                let s = &self.shapes[b..b + 3];
+                let s = &self.bank.shapes[b..b + 3];
                 acc += w.weights[k] * (s[0] as f64 * v[0] + s[1] as f64 * v[1] + s[2] as f64 * v[2]);
             }
             *o = acc;
@@ -125,11 +96,46 @@ impl SynthModel {
     /// Radiation proxy gain per mode [1/√kg]: the area-weighted RMS of the
     /// normal component of the shape over the surface,
     /// `g_i = √( Σ_T A_T · mean_corners((φ_i·n_T)²) / Σ_T A_T )`.
+    ///
+    /// Per-triangle areas and unit normals are computed once; then each mode
+    /// reads only its own (contiguous) shape block, summing over triangles
+    /// in index order.
     pub fn rms_normal_shapes(&self) -> Vec<f64> {
-        let s = &self.surface;
+        let s = self.surface();
         let nodes = s.positions.len();
-        let mut area_total = 0.0;
+        let faces = TriangleNormals::new(s);
+        let shapes = &self.bank.shapes;
         let mut acc = vec![0.0; self.mode_count()];
+        for (i, g) in acc.iter_mut().enumerate() {
+            let mode = &shapes[i * nodes * 3..(i + 1) * nodes * 3];
+            for (tri, (area, un)) in faces.triangles.iter().zip(&faces.area_normal) {
+                let mut sq = 0.0;
+                for &k in tri {
+                    let sh = &mode[k * 3..k * 3 + 3];
+                    let d = sh[0] as f64 * un[0] + sh[1] as f64 * un[1] + sh[2] as f64 * un[2];
+                    sq += d * d;
+                }
+                *g += area * sq / 3.0;
+            }
+        }
+        if faces.area_total > 0.0 {
+            acc.iter_mut().for_each(|g| *g = (*g / faces.area_total).sqrt());
+        }
+        acc
+    }
+}
+
+/// The non-degenerate corner triangles of a surface with their areas and
+/// outward unit normals, and the total area \[m²\].
+struct TriangleNormals {
+    triangles: Vec<[usize; 3]>,
+    area_normal: Vec<(f64, [f64; 3])>,
+    area_total: f64,
+}
+
+impl TriangleNormals {
+    fn new(s: &Surface) -> TriangleNormals {
+        let mut faces = TriangleNormals { triangles: Vec::new(), area_normal: Vec::new(), area_total: 0.0 };
         for tri in &s.triangles {
             let [a, b, c] = tri.map(|k| s.positions[k]);
             let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -141,22 +147,102 @@ impl SynthModel {
                 continue;
             }
             let area = 0.5 * twice_area;
-            let un = n.map(|x| x / twice_area);
-            area_total += area;
-            for (i, g) in acc.iter_mut().enumerate() {
-                let mut sq = 0.0;
-                for &k in tri {
-                    let base = (i * nodes + k) * 3;
-                    let sh = &self.shapes[base..base + 3];
-                    let d = sh[0] as f64 * un[0] + sh[1] as f64 * un[1] + sh[2] as f64 * un[2];
-                    sq += d * d;
-                }
-                *g += area * sq / 3.0;
-            }
+            faces.area_total += area;
+            faces.triangles.push(*tri);
+            faces.area_normal.push((area, n.map(|x| x / twice_area)));
         }
-        if area_total > 0.0 {
-            acc.iter_mut().for_each(|g| *g = (*g / area_total).sqrt());
+        faces
+    }
+}
+
+/// The consistency checks of [`SynthModel::shared`].
+fn check(bank: &ModeBank) -> Result<(), SynthError> {
+    let n = bank.frequencies_hz.len();
+    let nodes = bank.surface.positions.len();
+    let bad = |m: String| Err(SynthError::InconsistentBank(m));
+    if bank.decay_rates.len() != n || bank.damping_ratios.len() != n {
+        return bad(format!(
+            "{n} frequencies but {} decay rates and {} damping ratios",
+            bank.decay_rates.len(),
+            bank.damping_ratios.len()
+        ));
+    }
+    if Some(bank.shapes.len()) != n.checked_mul(nodes).and_then(|x| x.checked_mul(3)) {
+        return bad(format!("{} shape values, expected {n} modes × {nodes} nodes × 3", bank.shapes.len()));
+    }
+    // One branch-free (vectorized) pass; the position only on failure.
+    let all_finite = bank.shapes.iter().fold(true, |ok, x| ok & x.is_finite());
+    if let Some(k) = (!all_finite).then(|| bank.shapes.iter().position(|x| !x.is_finite())).flatten() {
+        let (mode, node) = (k / 3 / nodes.max(1), k / 3 % nodes.max(1));
+        return bad(format!("mode {mode} has a non-finite shape value at surface node {node}"));
+    }
+    if let Some(k) = bank.surface.positions.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        return bad(format!("surface node {k} has a non-finite position"));
+    }
+    if let Some(t) = bank.surface.triangles.iter().position(|t| t.iter().any(|&k| k >= nodes)) {
+        return bad(format!("surface triangle {t} refers to a node >= {nodes}"));
+    }
+    if let Some(e) = &bank.surface.triangle_edge_nodes {
+        if e.len() != bank.surface.triangles.len() {
+            return bad(format!(
+                "{} triangles but {} mid-edge triples",
+                bank.surface.triangles.len(),
+                e.len()
+            ));
         }
-        acc
+        if let Some(t) = e.iter().position(|t| t.iter().any(|&k| k >= nodes)) {
+            return bad(format!("mid-edge nodes of surface triangle {t} refer to a node >= {nodes}"));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::SyntheticBank;
+
+    /// A unit cube bank ([0, 1]³, 12 triangles) with three modes whose shapes
+    /// have known normal components: a translation along x (φ·n = ±1 on 2 of
+    /// the 6 faces), a breathing field φ = x − (½, ½, ½) (φ·n = ½ at every
+    /// corner of every face) and zero (a degenerate triangle is added too).
+    fn cube_bank() -> ModeBank {
+        let mut bank = SyntheticBank::preset("steel", 3).build();
+        bank.surface = crate::synthetic::box_surface([1.0, 1.0, 1.0]);
+        bank.surface.triangles.push([0, 0, 1]);
+        let p = bank.surface.positions.clone();
+        bank.shapes = p
+            .iter()
+            .map(|_| [1.0f32, 0.0, 0.0])
+            .chain(p.iter().map(|x| x.map(|c| (c - 0.5) as f32)))
+            .chain(p.iter().map(|_| [0.0f32; 3]))
+            .flatten()
+            .collect();
+        bank
+    }
+
+    #[test]
+    fn rms_normal_shapes_of_exact_fields() {
+        let g = SynthModel::new(&cube_bank()).expect("model").rms_normal_shapes();
+        // √(area of the 2 x-faces / total area) = √(1/3); breathing: ½; zero: 0.
+        assert!((g[0] - (1.0f64 / 3.0).sqrt()).abs() < 1e-15, "{}", g[0]);
+        assert!((g[1] - 0.5).abs() < 1e-15, "{}", g[1]);
+        assert_eq!(g[2], 0.0);
+    }
+
+    #[test]
+    fn a_shared_model_reads_the_bank_in_place() {
+        let bank = Arc::new(cube_bank());
+        let model = SynthModel::shared(Arc::clone(&bank)).expect("model");
+        assert!(std::ptr::eq(model.surface(), &bank.surface));
+        let hit = model.locate([0.5, 0.5, 1.05]).expect("on the top face");
+        let mut out = vec![0.0; 3];
+        model.shapes_dot(&hit, [0.0, 0.0, 1.0], &mut out);
+        assert_eq!(out, [0.0, 0.5, 0.0]);
+        // A non-finite shape value is found and named.
+        let mut bad = cube_bank();
+        bad.shapes[3 * 8 + 3 * 5 + 2] = f32::NAN;
+        let err = SynthModel::new(&bad).expect_err("NaN shape").to_string();
+        assert!(err.contains("mode 1") && err.contains("surface node 5"), "{err}");
     }
 }
