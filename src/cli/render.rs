@@ -6,6 +6,8 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use modal_bank::{BankCache, ModeBank};
+use modal_fem::Material;
+use modal_mesh::{Cells, TetMesh};
 use modal_precompute::{MeshSource, Request};
 use modal_scene::{BankProvider, BankRequest, ProviderError, Scene};
 use modal_synth::WavFormat;
@@ -38,24 +40,25 @@ impl BankProvider for PipelineProvider<'_> {
         }
         let mesh = request.mesh.as_ref().ok_or("the object names neither a mesh nor a bank")?;
         let material = request.material.clone().ok_or("an object given as a mesh needs a material")?;
+        let what = describe(mesh);
         let source = match mesh {
             modal_scene::MeshSource::File(path) => MeshSource::File(path.clone()),
             modal_scene::MeshSource::Generate(spec) => {
                 let shape = spec.shape()?;
                 let order = request.order.unwrap_or(2);
                 let h = spec.element_size.unwrap_or_else(|| shape.default_element_size(order));
+                let identity = format!("generated {shape:?} h={h:e}");
+                // The cache key of a generated mesh is its recipe: a cached
+                // bank is served without generating the mesh at all.
+                if let Some(bank) = self.cached_generated(request, &material, &identity, &what)? {
+                    return Ok(bank);
+                }
                 // At the requested order, so curved shapes get curved (P2) boundaries.
                 let mesh = modal_mesh::generate::generate(&shape, h, order)?;
-                MeshSource::Memory { mesh, identity: format!("generated {shape:?} h={h:e}") }
+                MeshSource::Memory { mesh, identity }
             }
         };
-        let mut pipeline = Request::new(source, material);
-        pipeline.scale = request.scale;
-        pipeline.order = request.order.unwrap_or(2);
-        // No modes above the scene's Nyquist frequency are worth solving for.
-        pipeline.max_freq_hz = request.max_frequency_hz;
-        pipeline.threads = self.threads;
-        let what = describe(mesh);
+        let pipeline = self.request(request, material, source);
         self.spinner.set(format!("mode bank for {what}"));
         let outcome = modal_precompute::precompute(&pipeline, self.cache.as_ref(), false, &mut |_| {})
             .map_err(|e| format!("{what}: {e}"))?;
@@ -67,6 +70,57 @@ impl BankProvider for PipelineProvider<'_> {
         }
         Ok(Arc::new(outcome.bank))
     }
+}
+
+impl PipelineProvider<'_> {
+    /// The precompute request for a scene object's bank.
+    fn request(&self, request: &BankRequest, material: Material, source: MeshSource) -> Request {
+        let mut pipeline = Request::new(source, material);
+        pipeline.scale = request.scale;
+        pipeline.order = request.order.unwrap_or(2);
+        // No modes above the scene's Nyquist frequency are worth solving for.
+        pipeline.max_freq_hz = request.max_frequency_hz;
+        pipeline.threads = self.threads;
+        pipeline
+    }
+
+    /// The cached bank of a generated mesh named by `identity` (`what` in
+    /// messages), looked up by
+    /// its cache key (which reads only the identity of an in-memory mesh, so
+    /// an empty mesh stands in for the one not generated). `None` when there
+    /// is no cache or no valid entry: the caller then runs the pipeline,
+    /// which reports a damaged entry and recomputes it.
+    fn cached_generated(
+        &mut self,
+        request: &BankRequest,
+        material: &Material,
+        identity: &str,
+        what: &str,
+    ) -> Result<Option<Arc<ModeBank>>, ProviderError> {
+        let Some(cache) = &self.cache else { return Ok(None) };
+        let placeholder = TetMesh { nodes: Vec::new(), cells: Cells::Tet4(Vec::new()), groups: Vec::new() };
+        let source = MeshSource::Memory { mesh: placeholder, identity: identity.to_string() };
+        let key = modal_precompute::cache_key(&self.request(request, material.clone(), source))?;
+        let Ok(Some(bank)) = cache.get(&key) else { return Ok(None) };
+        self.warnings.extend(residual_floor_warning(&bank).map(|w| format!("{what}: {w}")));
+        self.cached += 1;
+        Ok(Some(Arc::new(bank)))
+    }
+}
+
+/// The warning the pipeline gives for a cached bank whose residuals stay
+/// above [`modal_precompute::TARGET_RESIDUAL`].
+fn residual_floor_warning(bank: &ModeBank) -> Option<String> {
+    let above = bank.residuals.iter().filter(|&&r| r > modal_precompute::TARGET_RESIDUAL).count();
+    let worst = bank.residuals.iter().copied().fold(0.0, f64::max);
+    (above > 0).then(|| {
+        format!(
+            "{above} of {} modes have residuals up to {worst:.1e} > {:.0e}: the limit of double precision \
+             for this mesh; the frequencies stay accurate",
+            bank.residuals.len(),
+            modal_precompute::TARGET_RESIDUAL
+        )
+    })
 }
 
 fn describe(mesh: &modal_scene::MeshSource) -> String {
