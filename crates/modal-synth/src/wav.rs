@@ -44,6 +44,20 @@ impl Default for WavGain {
     }
 }
 
+/// Frames per block of the 16-bit writer.
+const PCM_BLOCK_FRAMES: usize = 16_384;
+
+/// A sample (full scale = 1) as 16-bit PCM: clamped to ±1, times 32767,
+/// rounded half away from zero — `(x.clamp(-1, 1) · 32767).round()` exactly,
+/// without the libm call: truncation is exact, and so is the remainder
+/// `y − trunc(y)` for |y| ≤ 32767.
+fn pcm16(x: f64) -> i16 {
+    let y = x.clamp(-1.0, 1.0) * 32767.0;
+    let t = y as i32;
+    let r = y - t as f64;
+    (t + i32::from(r >= 0.5) - i32::from(r <= -0.5)) as i16
+}
+
 /// What [`write_wav`] wrote.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WavReport {
@@ -87,7 +101,10 @@ pub fn write_wav(
     if channels.iter().any(|c| c.iter().any(|x| !x.is_finite())) {
         return Err(SynthError::WavChannels("a sample is NaN or infinite".into()));
     }
-    let raw_peak = channels.iter().flat_map(|c| c.iter()).fold(0.0f64, |m, &x| m.max((x as f64).abs()));
+    // Finite samples: a plain compare finds the largest magnitude (exact in f32).
+    let raw_peak =
+        channels.iter().flat_map(|c| c.iter()).fold(0.0f32, |m, &x| if x.abs() > m { x.abs() } else { m });
+    let raw_peak = raw_peak as f64;
     let g = match gain {
         WavGain::Fixed(g) if g.is_finite() => g,
         WavGain::Normalize { peak } if peak.is_finite() && peak > 0.0 => {
@@ -128,19 +145,28 @@ pub fn write_wav(
     let mut clipped = 0;
     {
         let mut w = hound::WavWriter::new(BufWriter::new(tmp.as_file_mut()), spec).map_err(|e| fail(&e))?;
-        for f in 0..frames {
-            for c in channels {
-                let x = c[f] as f64 * g;
-                match format {
-                    WavFormat::Float32 => w.write_sample(x as f32),
-                    WavFormat::Pcm16 => {
-                        if x.abs() > 1.0 {
-                            clipped += 1;
-                        }
-                        w.write_sample((x.clamp(-1.0, 1.0) * 32767.0).round() as i16)
+        match format {
+            WavFormat::Float32 => {
+                for f in 0..frames {
+                    for c in channels {
+                        w.write_sample((c[f] as f64 * g) as f32).map_err(|e| fail(&e))?;
                     }
                 }
-                .map_err(|e| fail(&e))?;
+            }
+            WavFormat::Pcm16 => {
+                // Blocks of frames through hound's buffered 16-bit writer.
+                for first in (0..frames).step_by(PCM_BLOCK_FRAMES) {
+                    let len = PCM_BLOCK_FRAMES.min(frames - first);
+                    let mut block = w.get_i16_writer((len * channels.len()) as u32);
+                    for f in first..first + len {
+                        for c in channels {
+                            let x = c[f] as f64 * g;
+                            clipped += usize::from(x.abs() > 1.0);
+                            block.write_sample(pcm16(x));
+                        }
+                    }
+                    block.flush().map_err(|e| fail(&e))?;
+                }
             }
         }
         w.finalize().map_err(|e| fail(&e))?;
@@ -154,4 +180,29 @@ pub fn write_wav(
         peak: raw_peak * g,
         clipped,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The definition [`pcm16`] must reproduce.
+    fn pcm16_reference(x: f64) -> i16 {
+        (x.clamp(-1.0, 1.0) * 32767.0).round() as i16
+    }
+
+    #[test]
+    fn pcm16_rounds_like_f64_round() {
+        // Exact halves (ties away from zero), their neighbours, the clamp,
+        // and a dense sweep of full scale.
+        let mut xs = vec![0.0, -0.0, 1.0, -1.0, 1.5, -7.0, 0.5 / 32767.0, -0.5 / 32767.0];
+        for k in -32767i32..=32767 {
+            let half = (k as f64 + 0.5) / 32767.0;
+            xs.extend([half, f64::from_bits(half.to_bits() + 1), f64::from_bits(half.to_bits() - 1)]);
+        }
+        xs.extend((0..200_001).map(|i| -1.0 + i as f64 * 1e-5));
+        for x in xs {
+            assert_eq!(pcm16(x), pcm16_reference(x), "x = {x:e}");
+        }
+    }
 }
