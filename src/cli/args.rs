@@ -224,7 +224,7 @@ pub struct PrecomputeArgs {
     /// Do not read or write the cache.
     #[arg(long)]
     pub no_cache: bool,
-    /// Threads of the sparse factorization and solves (default 1: measured fastest on 2 cores; assembly uses all cores).
+    /// Solver threads (default: one per core); the modes do not depend on the count.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Print one JSON object on stdout instead of the table.
@@ -334,7 +334,7 @@ pub struct RenderArgs {
     /// Print one JSON report on stdout.
     #[arg(long)]
     pub json: bool,
-    /// Threads of the sparse factorization and solves (default 1: measured fastest on 2 cores; assembly uses all cores).
+    /// Solver threads (default: one per core); the modes do not depend on the count.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
 }

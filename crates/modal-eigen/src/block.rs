@@ -11,42 +11,43 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
-/// Y = A X for a sparse A (any storage; used with full symmetric K and M).
+/// Rows of Y computed per parallel task in [`spmm`].
+const SPMM_ROWS_PER_TASK: usize = 2048;
+
+/// Y = A X for a sparse **symmetric** A in full storage (K and M).
 ///
-/// X is copied to row-major blocks of `p` values per row so that A is streamed once for all
-/// columns (faer's generic sparse×dense product streams A once per column).
+/// Gather form: column j of A is row j, so `Y[j, :] = Σᵢ A[i, j] X[i, :]` — every output
+/// row is written by one task, the rows are split over rayon's threads, and each row's sum
+/// runs in the same order whatever the thread count (results are bit-identical). X and Y go
+/// through row-major copies so that A is streamed once for all columns.
 pub fn spmm(a: SparseColMatRef<'_, usize, f64>, x: MatRef<'_, f64>) -> Mat<f64> {
+    use rayon::prelude::*;
+    debug_assert_eq!(a.nrows(), a.ncols(), "spmm: A must be square (symmetric)");
     let (n, p) = (a.nrows(), x.ncols());
     let mut y = Mat::zeros(n, p);
     if p == 0 {
         return y;
     }
-    let nc = a.ncols();
-    let mut xr = vec![0.0; nc * p];
+    let mut xr = vec![0.0; n * p];
     for j in 0..p {
         for (i, v) in x.col(j).iter().enumerate() {
             xr[i * p + j] = *v;
         }
     }
     let mut yr = vec![0.0; n * p];
-    let (sym, vals) = (a.symbolic(), a.val());
-    let col_ptr = sym.col_ptr();
-    let row_idx = sym.row_idx();
-    let col_nnz = sym.col_nnz();
-    for c in 0..nc {
-        let start = col_ptr[c];
-        let end = match col_nnz {
-            Some(nnz) => start + nnz[c],
-            None => col_ptr[c + 1],
-        };
-        let xc = &xr[c * p..(c + 1) * p];
-        for (&r, &v) in row_idx[start..end].iter().zip(&vals[start..end]) {
-            let yrow = &mut yr[r * p..(r + 1) * p];
-            for (yv, xv) in yrow.iter_mut().zip(xc) {
-                *yv += v * xv;
+    let sym = a.symbolic();
+    let vals = a.val();
+    yr.par_chunks_mut(SPMM_ROWS_PER_TASK * p).enumerate().for_each(|(chunk, out)| {
+        for (r, yrow) in out.chunks_exact_mut(p).enumerate() {
+            let j = chunk * SPMM_ROWS_PER_TASK + r;
+            let range = sym.col_range(j);
+            for (&i, &v) in sym.row_idx()[range.clone()].iter().zip(&vals[range]) {
+                for (yv, xv) in yrow.iter_mut().zip(&xr[i * p..(i + 1) * p]) {
+                    *yv += v * xv;
+                }
             }
         }
-    }
+    });
     for j in 0..p {
         for (i, v) in y.as_mut().col_mut(j).iter_mut().enumerate() {
             *v = yr[i * p + j];

@@ -17,6 +17,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, Mat, MatRef, Par};
+use std::time::Instant;
 
 /// Parameters of one Krylov–Schur search.
 pub struct KsConfig {
@@ -65,7 +66,6 @@ pub struct KsOutput {
     /// M-orthonormal eigenvectors (columns).
     pub vectors: Mat<f64>,
     /// Relative residuals.
-    #[allow(dead_code)]
     pub residuals: Vec<f64>,
     /// Restarts done.
     pub restarts: usize,
@@ -81,6 +81,12 @@ pub struct Counters {
     pub block_solves: usize,
     /// Explicit residual checks of candidate Ritz pairs.
     pub residual_checks: usize,
+    /// Seconds in block solves.
+    pub block_solve_s: f64,
+    /// Seconds orthogonalizing new blocks.
+    pub orthogonalize_s: f64,
+    /// Seconds in Rayleigh–Ritz of the projected matrix and explicit residual checks.
+    pub residual_check_s: f64,
 }
 
 /// Relative residuals ‖K y − λ M y‖ / (|λ| ‖M y‖) of columns of `y`.
@@ -161,9 +167,12 @@ pub fn search(
         // Expand the basis by blocks until full, checking convergence as we go.
         let mut stop = None;
         while k + p <= ncv {
+            let t = Instant::now();
             let mut x = mv.as_ref().subcols(k, p).to_owned();
             factor.solve_in_place(x.as_mut(), MemStack::new(&mut buf));
             counters.block_solves += 1;
+            counters.block_solve_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
             let (b, c, mx) = next_block(
                 m,
                 defl,
@@ -177,8 +186,12 @@ pub fn search(
             h.as_mut().submatrix_mut(k + p, k, p, p).copy_from(b.as_ref());
             v.as_mut().subcols_mut(k + p, p).copy_from(x.as_ref());
             k += p;
+            counters.orthogonalize_s += t.elapsed().as_secs_f64();
             if k >= check_from {
-                if let Some(out) = try_finish(&h, &v, k, p, sigma, gate, cfg, k_mat, m, enough, early)? {
+                let t = Instant::now();
+                let finish = try_finish(&h, &v, k, p, sigma, gate, cfg, k_mat, m, enough, early)?;
+                counters.residual_check_s += t.elapsed().as_secs_f64();
+                if let Some(out) = finish {
                     counters.residual_checks += 1;
                     match out {
                         Finish::Done(o) => {

@@ -32,7 +32,9 @@ pub struct EigenOptions {
     pub block_size: usize,
     /// Fill-reducing ordering. Default [`Ordering::Auto`].
     pub ordering: Ordering,
-    /// Threads for faer (0 or 1: sequential, measured as fast on 2 cores). Default 1.
+    /// Solver threads (0: one per core). Block solves run as two column groups and sparse
+    /// products by row ranges on these threads; the result does not depend on the count.
+    /// Default 0.
     pub threads: usize,
     /// Refuse to factor if the estimated memory exceeds this many bytes.
     /// `None`: 75 % of `MemAvailable` from /proc/meminfo (no limit if unreadable).
@@ -56,7 +58,7 @@ impl Default for EigenOptions {
             tolerance: 1e-8,
             block_size: 8,
             ordering: Ordering::Auto,
-            threads: 1,
+            threads: 0,
             memory_limit_bytes: None,
             max_restarts: 200,
             overlap_check: true,
@@ -108,6 +110,12 @@ pub struct SolveStats {
     pub solve_s: f64,
     /// Seconds in final residuals and inertia checks.
     pub check_s: f64,
+    /// Of `solve_s`: seconds in block solves with the factor.
+    pub block_solve_s: f64,
+    /// Of `solve_s`: seconds orthogonalizing new blocks (CGS2 + SVQB, incl. M products).
+    pub orthogonalize_s: f64,
+    /// Of `solve_s`: seconds in explicit residual checks of candidate Ritz pairs.
+    pub residual_check_s: f64,
     /// Ordering used.
     pub ordering: Option<OrderingUsed>,
     /// Spectrum scale maxᵢ Kᵢᵢ/Mᵢᵢ (rad²/s²); each mode's residual bound is
