@@ -37,6 +37,10 @@ pub(crate) fn atomic_write(
     Ok(())
 }
 
+fn is_file(f: &std::fs::File) -> bool {
+    f.metadata().is_ok_and(|m| m.is_file())
+}
+
 /// Reads a whole regular file.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, BankError> {
     let read_err = |source| BankError::Read { path: path.to_path_buf(), source };
@@ -58,6 +62,15 @@ impl ModeBank {
     /// Reads, verifies (format, version, checksum, shapes) and validates the
     /// bank at `path`. Content errors do not repeat the path; I/O errors do.
     pub fn load(path: impl AsRef<Path>) -> Result<ModeBank, BankError> {
-        ModeBank::from_bytes(&read_file(path.as_ref())?)
+        let path = path.as_ref();
+        let fast = std::fs::File::open(path)
+            .ok()
+            .filter(is_file)
+            .and_then(|mut f| crate::format::decode_file(&mut f));
+        match fast {
+            Some(bank) => Ok(bank),
+            // Anything unusual: the plain path gives the exact error.
+            None => ModeBank::from_bytes(&read_file(path)?),
+        }
     }
 }

@@ -122,6 +122,10 @@ fn check_damping(bank: &ModeBank) -> Result<(), BankError> {
 
 fn check_shapes(bank: &ModeBank) -> Result<(), BankError> {
     let s = bank.surface.positions.len().max(1);
+    // One branch-free (vectorized) pass; the position only on failure.
+    if bank.shapes.iter().fold(true, |ok, v| ok & v.is_finite()) {
+        return Ok(());
+    }
     match bank.shapes.iter().position(|v| !v.is_finite()) {
         Some(k) => Err(BankError::NonFinite {
             field: format!("shapes[mode {}, surface node {}, component {}]", k / 3 / s, (k / 3) % s, k % 3),

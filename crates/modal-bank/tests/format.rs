@@ -478,3 +478,42 @@ fn measured_non_rayleigh_damping_is_legal_if_consistent() {
     let err = bank.validate().unwrap_err();
     assert!(err.to_string().starts_with("inconsistent bank: decay_rates[2]"), "{err}");
 }
+
+/// `ModeBank::load` reads the shapes straight into the bank (its own path);
+/// it must agree with `from_bytes` on the same bytes: the same bank, bit for
+/// bit, or the same error.
+#[test]
+fn load_agrees_with_from_bytes_on_good_and_bad_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("b.bank");
+    let mut nothing = linear_bank(0);
+    nothing.surface = Default::default();
+    nothing.mass = common::cube_mass(0.0, 1.0);
+    let mut variants: Vec<Vec<u8>> = [linear_bank(5), quadratic_bank(3), linear_bank(0), nothing]
+        .iter()
+        .map(|b| b.to_bytes().unwrap())
+        .collect();
+    let bytes = quadratic_bank(2).to_bytes().unwrap();
+    variants.extend((0..bytes.len()).step_by(7).map(|len| bytes[..len].to_vec()));
+    variants.extend((0..bytes.len()).step_by(5).map(|pos| {
+        let mut bad = bytes.clone();
+        bad[pos] ^= 1 << (pos % 8);
+        bad
+    }));
+    let mut longer = bytes.clone();
+    longer.push(0);
+    variants.push(longer);
+    let mut loaded = 0;
+    for (i, v) in variants.iter().enumerate() {
+        std::fs::write(&path, v).unwrap();
+        match (ModeBank::load(&path), ModeBank::from_bytes(v)) {
+            (Ok(a), Ok(b)) => {
+                assert_bit_identical(&a, &b);
+                loaded += 1;
+            }
+            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "variant {i}"),
+            (a, b) => panic!("variant {i}: load gave {a:?}, from_bytes {b:?}"),
+        }
+    }
+    assert!(loaded >= 4, "{loaded} variants loaded");
+}

@@ -87,11 +87,41 @@ fn check_format(meta: Option<&HashMap<String, String>>) -> Result<&HashMap<Strin
     }
 }
 
-fn raw_tensors<'a>(meta: &'a Metadata, data: &'a [u8]) -> Result<HashMap<String, Raw<'a>>, BankError> {
+/// The tensor data region (offsets relative to its start), held in one
+/// piece, or in three when one tensor was read into its own buffer: the
+/// bytes before it, its bytes (starting at `split.0`), the bytes after it
+/// (starting at `split.1`). Tensors never straddle pieces (safetensors
+/// tensors are contiguous and disjoint).
+#[derive(Clone, Copy)]
+struct Region<'a> {
+    pieces: [&'a [u8]; 3],
+    split: (usize, usize),
+}
+
+impl<'a> Region<'a> {
+    fn whole(data: &'a [u8]) -> Region<'a> {
+        Region { pieces: [data, &[], &[]], split: (usize::MAX, usize::MAX) }
+    }
+
+    /// Bytes `a..b` of the region, if they lie inside one piece.
+    fn get(&self, a: usize, b: usize) -> Option<&'a [u8]> {
+        let (s0, s1) = self.split;
+        let (piece, base) = if a < s0 || (a == s0 && b == s0) {
+            (self.pieces[0], 0)
+        } else if a < s1 || (a == s1 && b == s1) {
+            (self.pieces[1], s0)
+        } else {
+            (self.pieces[2], s1)
+        };
+        piece.get(a.checked_sub(base)?..b.checked_sub(base)?)
+    }
+}
+
+fn raw_tensors<'a>(meta: &'a Metadata, data: Region<'a>) -> Result<HashMap<String, Raw<'a>>, BankError> {
     let mut out = HashMap::new();
     for (name, info) in meta.tensors() {
         let (a, b) = info.data_offsets;
-        let Some(bytes) = data.get(a..b) else {
+        let Some(bytes) = data.get(a, b) else {
             return Err(BankError::NotSafetensors(format!("tensor '{name}' lies outside the file")));
         };
         out.insert(name, Raw { dtype: info.dtype, shape: &info.shape, data: bytes });
@@ -224,7 +254,9 @@ fn json<T: serde::de::DeserializeOwned>(meta: &HashMap<String, String>, key: &st
     serde_json::from_str(text).map_err(|e| BankError::BadMetadata { key: key.into(), detail: e.to_string() })
 }
 
-fn bank(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Result<ModeBank, BankError> {
+/// Every field of the bank but `shapes` (left empty), whose dtype and shape
+/// are checked here; the caller fills it and validates.
+fn bank_without_shapes(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Result<ModeBank, BankError> {
     let material: Material = json(meta, KEY_MATERIAL)?;
     let info: SolveInfo = json(meta, KEY_SOLVE_INFO)?;
     let hash = meta.get(KEY_INPUT_HASH).ok_or_else(|| BankError::MissingMetadata(KEY_INPUT_HASH.into()))?;
@@ -238,25 +270,152 @@ fn bank(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Result<ModeBank, Ban
     let surface = surface(t)?;
     let s = surface.positions.len();
     let per_mode = [Some(n)];
-    let bank = ModeBank {
-        frequencies_hz: t.f64s(T_FREQUENCIES, &per_mode)?,
-        damping_ratios: t.f64s(T_DAMPING_RATIOS, &per_mode)?,
-        decay_rates: t.f64s(T_DECAY_RATES, &per_mode)?,
-        residuals: t.f64s(T_RESIDUALS, &per_mode)?,
-        shapes: t.f32s(T_SHAPES, &[Some(n), Some(s), Some(3)])?,
+    let frequencies_hz = t.f64s(T_FREQUENCIES, &per_mode)?;
+    let damping_ratios = t.f64s(T_DAMPING_RATIOS, &per_mode)?;
+    let decay_rates = t.f64s(T_DECAY_RATES, &per_mode)?;
+    let residuals = t.f64s(T_RESIDUALS, &per_mode)?;
+    t.get(T_SHAPES, Dtype::F32, &shapes_shape(n, s))?;
+    Ok(ModeBank {
+        frequencies_hz,
+        damping_ratios,
+        decay_rates,
+        residuals,
+        shapes: Vec::new(),
         surface,
         material,
         mass: mass(t)?,
         info,
-    };
-    bank.validate()?;
-    Ok(bank)
+    })
+}
+
+/// The shape of the `shapes` tensor: modes × surface nodes × 3.
+fn shapes_shape(modes: usize, nodes: usize) -> [Option<usize>; 3] {
+    [Some(modes), Some(nodes), Some(3)]
 }
 
 pub(super) fn from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
     let (header, data) = read_header(bytes)?;
     let meta = check_format(header.metadata().as_ref())?;
-    let raw = raw_tensors(&header, data)?;
-    verify_checksum(&raw, meta)?;
-    bank(&Tensors(raw), meta)
+    let raw = raw_tensors(&header, Region::whole(data))?;
+    checked_bank(Tensors(raw), meta, |t, mut bank| {
+        bank.shapes = t.f32s(T_SHAPES, &shapes_shape(bank.mode_count(), bank.surface_node_count()))?;
+        bank.validate()?;
+        Ok(bank)
+    })
+}
+
+/// Verifies the checksum on one thread while the other decodes the bank's
+/// fields but `shapes` and hands them to `finish`; a checksum mismatch is
+/// reported before any other error.
+fn checked_bank(
+    t: Tensors<'_>,
+    meta: &HashMap<String, String>,
+    finish: impl FnOnce(&Tensors<'_>, ModeBank) -> Result<ModeBank, BankError> + Send,
+) -> Result<ModeBank, BankError> {
+    let (sum, bank) =
+        rayon::join(|| verify_checksum(&t.0, meta), || finish(&t, bank_without_shapes(&t, meta)?));
+    sum?;
+    bank
+}
+
+/// [`from_bytes`] for a file, reading the `shapes` tensor (most of a bank's
+/// bytes) straight into the bank's own buffer instead of reading the whole
+/// file into memory and converting it. Same checks, same result as
+/// [`from_bytes`] on the file's bytes; `None` for anything unusual — any
+/// error, an I/O failure, a file that changes length while read — so the
+/// caller falls back to [`from_bytes`] for the exact error.
+pub(super) fn from_file(file: &mut std::fs::File) -> Option<ModeBank> {
+    use std::io::Read;
+    let len = file.metadata().ok()?.len();
+    let mut prefix = [0u8; 8];
+    file.read_exact(&mut prefix).ok()?;
+    let n = u64::from_le_bytes(prefix);
+    if n > MAX_HEADER_BYTES || 8 + n > len {
+        return None;
+    }
+    let mut head = vec![0u8; n as usize];
+    file.read_exact(&mut head).ok()?;
+    let header: Metadata = serde_json::from_slice(&head).ok()?;
+    if 8 + n + header.data_len() as u64 != len {
+        return None;
+    }
+    let (a, b) = header.info(T_SHAPES).filter(|i| i.dtype == Dtype::F32)?.data_offsets;
+    let mut before = vec![0u8; a];
+    let mut values = vec![0f32; (b - a) / 4];
+    let mut after = vec![0u8; header.data_len() - b];
+    file.read_exact(&mut before).ok()?;
+    file.read_exact(bytemuck::cast_slice_mut(&mut values)).ok()?;
+    file.read_exact(&mut after).ok()?;
+    if file.read(&mut [0u8]).ok()? != 0 {
+        return None;
+    }
+    let meta = check_format(header.metadata().as_ref()).ok()?;
+    let region = Region { pieces: [&before, bytemuck::cast_slice(&values), &after], split: (a, b) };
+    let raw = raw_tensors(&header, region).ok()?;
+    // The buffer holds the file's little-endian bytes: bring them to native
+    // order once the checksum (of those bytes) is done.
+    let mut bank = checked_bank(Tensors(raw), meta, |_, bank| Ok(bank)).ok()?;
+    values.iter_mut().for_each(|x| *x = f32::from_bits(u32::from_le(x.to_bits())));
+    bank.shapes = values;
+    bank.validate().ok()?;
+    Some(bank)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SolveInfo;
+    use modal_fem::{MassProperties, Material};
+
+    fn bank(modes: usize) -> ModeBank {
+        let surface = Surface {
+            node_ids: vec![10, 11, 12, 13],
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            triangle_edge_nodes: None,
+        };
+        let mut bank = ModeBank {
+            frequencies_hz: (0..modes).map(|i| 100.0 * (i + 1) as f64).collect(),
+            damping_ratios: Vec::new(),
+            decay_rates: Vec::new(),
+            residuals: vec![1e-10; modes],
+            shapes: (0..modes * 12).map(|k| (k as f32 * 0.37).sin()).collect(),
+            surface,
+            material: Material::preset("steel").expect("steel"),
+            mass: MassProperties {
+                volume_m3: 1.0 / 6.0,
+                mass_kg: 1300.0,
+                center_of_mass_m: [0.25; 3],
+                inertia_kg_m2: [[10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 10.0]],
+            },
+            info: SolveInfo::default(),
+        };
+        bank.recompute_damping();
+        bank
+    }
+
+    #[test]
+    fn a_good_file_takes_the_direct_path() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        for modes in [0, 1, 6] {
+            let original = bank(modes);
+            let path = dir.path().join("b.bank");
+            original.save(&path).expect("save");
+            let mut file = std::fs::File::open(&path).expect("open");
+            assert_eq!(from_file(&mut file), Some(original), "{modes} modes");
+        }
+    }
+
+    #[test]
+    fn region_pieces_serve_the_tensors_inside_them() {
+        let data: Vec<u8> = (0..20).collect();
+        let r = Region { pieces: [&data[..8], &data[8..16], &data[16..]], split: (8, 16) };
+        assert_eq!(r.get(0, 8), Some(&data[..8]));
+        assert_eq!(r.get(8, 16), Some(&data[8..16]));
+        assert_eq!(r.get(16, 20), Some(&data[16..]));
+        assert_eq!(r.get(8, 8), Some(&[][..]));
+        assert_eq!(r.get(4, 12), None, "straddles two pieces");
+        assert_eq!(r.get(18, 24), None, "beyond the end");
+        assert_eq!(Region::whole(&data).get(3, 19), Some(&data[3..19]));
+    }
 }

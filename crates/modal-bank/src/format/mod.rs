@@ -53,6 +53,12 @@ pub(crate) const UNITS: [(&str, &str); 11] = [
     ("material", "SI: youngs_pa Pa, density_kg_m3 kg/m^3, alpha 1/s, beta s"),
 ];
 
+/// A bank file decoded straight into the bank's buffers (see
+/// `decode::from_file`); `None` when the plain path must be taken.
+pub(crate) fn decode_file(file: &mut std::fs::File) -> Option<ModeBank> {
+    decode::from_file(file)
+}
+
 impl ModeBank {
     /// Encodes the bank as a safetensors file in memory (validates first).
     pub fn to_bytes(&self) -> Result<Vec<u8>, BankError> {
