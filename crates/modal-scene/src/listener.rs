@@ -45,12 +45,24 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// Catmull-Rom interpolation of `s` at fractional index `x` (zero outside).
 fn read(s: &[f32], x: f64) -> f64 {
-    let i = x.floor();
-    let f = x - i;
-    let i = i as i64;
-    let at = |k: i64| if k >= 0 && (k as usize) < s.len() { s[k as usize] as f64 } else { 0.0 };
-    let (p0, p1, p2, p3) = (at(i - 1), at(i), at(i + 1), at(i + 2));
+    let i = floor_i64(x);
+    let f = x - i as f64;
+    let (p0, p1, p2, p3) = match s.get(i.wrapping_sub(1) as usize..).and_then(|t| t.get(..4)) {
+        // The interior (every tap inside `s`) without per-tap checks.
+        Some(t) if i >= 1 => (t[0] as f64, t[1] as f64, t[2] as f64, t[3] as f64),
+        _ => {
+            let at = |k: i64| if k >= 0 && (k as usize) < s.len() { s[k as usize] as f64 } else { 0.0 };
+            (at(i - 1), at(i), at(i + 1), at(i + 2))
+        }
+    };
     p1 + 0.5 * f * (p2 - p0 + f * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + f * (3.0 * (p1 - p2) + p3 - p0)))
+}
+
+/// `x.floor()` as an integer, exactly, without the libm call (`x` finite,
+/// |x| < 2⁶³): truncation toward zero, one less for negative non-integers.
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    t - i64::from((t as f64) > x)
 }
 
 /// Adds what an ear at `ear` hears of signal `s` (whose sample 0 is emitted
@@ -110,6 +122,32 @@ mod tests {
         // Exact for quadratics inside the support.
         let x: f64 = 4.3;
         assert!((read(&s, x) - (x * 0.5).powi(2)).abs() < 1e-5);
+    }
+
+    /// The definition [`read`] must reproduce, bit for bit.
+    fn read_reference(s: &[f32], x: f64) -> f64 {
+        let i = x.floor();
+        let f = x - i;
+        let i = i as i64;
+        let at = |k: i64| if k >= 0 && (k as usize) < s.len() { s[k as usize] as f64 } else { 0.0 };
+        let (p0, p1, p2, p3) = (at(i - 1), at(i), at(i + 1), at(i + 2));
+        p1 + 0.5 * f * (p2 - p0 + f * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + f * (3.0 * (p1 - p2) + p3 - p0)))
+    }
+
+    #[test]
+    fn read_equals_the_reference_inside_at_and_beyond_the_edges() {
+        let s: Vec<f32> = (0..37).map(|k| ((k * 7919) % 101) as f32 / 50.0 - 1.0).collect();
+        let mut x: f64 = -5.0;
+        while x < 45.0 {
+            for v in [x, -x, x.floor(), x.floor() - f64::EPSILON, f64::from_bits(x.to_bits() + 1)] {
+                assert_eq!(read(&s, v).to_bits(), read_reference(&s, v).to_bits(), "x = {v}");
+            }
+            x += 0.0371;
+        }
+        for v in [-1e12, -2.5, -0.5, -0.0, 0.0, 1e-300, -1e-300, 35.0, 36.0, 36.5, 1e15] {
+            assert_eq!(read(&s, v).to_bits(), read_reference(&s, v).to_bits(), "x = {v}");
+        }
+        assert_eq!(read(&[], 0.5), 0.0);
     }
 
     #[test]
