@@ -249,8 +249,17 @@ fn solve_bank(
     clamped_parts.dedup();
     let rigid_full =
         modal_fem::rigid_body_fields(nodes, &assembled.part_of_node, assembled.parts, &clamped_parts);
-    let modal_fem::Restricted { k, m, dofs: dof_map } =
-        modal_fem::restrict(&assembled.k, &assembled.m, &clamped)?;
+    // Without clamps the assembled matrices are solved as they are (a copy of K and M
+    // costs ≈ 1.5 % of a 30k-DOF precompute).
+    let restricted = if clamped.iter().any(|&c| c) {
+        Some(modal_fem::restrict(&assembled.k, &assembled.m, &clamped)?)
+    } else {
+        None
+    };
+    let (k, m, dof_map) = match &restricted {
+        Some(r) => (&r.k, &r.m, r.dofs.clone()),
+        None => (&assembled.k, &assembled.m, modal_fem::DofMap::from_clamped(&clamped)),
+    };
     let rigid = restrict_rows(&rigid_full, &dof_map.free_to_full);
     let options = EigenOptions {
         min_freq_hz: request.min_freq_hz,
@@ -261,7 +270,7 @@ fn solve_bank(
     };
     let rigid_ref = (rigid.ncols() > 0).then(|| rigid.as_ref());
     let solution =
-        modal_eigen::solve(&k, &m, rigid_ref, &options, &mut |p| progress(Stage::Solve(format!("{p:?}"))))?;
+        modal_eigen::solve(k, m, rigid_ref, &options, &mut |p| progress(Stage::Solve(format!("{p:?}"))))?;
     Ok(build_bank(request, assembled, &dof_map, &solution, input_hash))
 }
 
