@@ -172,12 +172,17 @@ pub fn render(
     check_ground_clearance(original, &banks[..original.objects.len()])?;
 
     let names: Vec<String> = (0..scene.objects.len()).map(|i| scene.object_name(i)).collect();
-    let sim = simulate(scene, &banks, &names, opts, &mut report)?;
+    // The synthesis models do not depend on the physics: they are built on
+    // the second core while the (single-threaded) physics runs.
+    let (sim, models) =
+        rayon::join(|| simulate(scene, &banks, &names, opts, &mut report), || distinct_models(&banks));
+    let sim = sim?;
 
     let t = Instant::now();
     let fs = scene.sample_rate_hz as f64;
     let total = (scene.duration_s * fs).round() as usize;
-    let signals = synthesize(scene, &banks, &names, &sim.strikes, &sim.trajectories, total)?;
+    let per_object = shared_models(&banks, &names, &sim.strikes, models)?;
+    let signals = synthesize(scene, &banks, &per_object, &sim.strikes, &sim.trajectories, total)?;
     report.synthesis_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -280,12 +285,12 @@ type SharedModel = (Arc<SynthModel>, Arc<Vec<f64>>);
 fn synthesize(
     scene: &Scene,
     banks: &[Arc<ModeBank>],
-    names: &[String],
+    per_object: &[Option<SharedModel>],
     strikes: &[Vec<Strike>],
     paths: &[Trajectory],
     total: usize,
 ) -> Result<Vec<Signal>, SceneError> {
-    let per_object = shared_models(banks, names, strikes)?;
+    let names = |i: usize| scene.object_name(i);
     let fs = scene.sample_rate_hz as f64;
     let ears = ears(scene);
     // Phase 1: every struck voice up to its last strike (its peak is known then).
@@ -300,7 +305,7 @@ fn synthesize(
                 ..SynthOptions::default()
             };
             let voice = ModalVoice::from_model(Arc::clone(model), opts)
-                .map_err(|e| SceneError::Synthesis { object: names[i].clone(), message: e.to_string() })?;
+                .map_err(|e| SceneError::Synthesis { object: names(i), message: e.to_string() })?;
             let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
             let (near, far) = distance_range(&paths[i], &ears);
             Ok(VoiceRun::start(voice, &strikes[i], total, fs, scale, near, far).map(|mut run| {
@@ -330,35 +335,51 @@ fn synthesize(
         .collect())
 }
 
-/// One checked synthesis model and its radiation gains per distinct bank,
-/// `None` for objects never struck.
+/// A model (or why the bank cannot be synthesized) per distinct bank, keyed
+/// by the first object using it.
+type DistinctModels = Vec<(usize, Result<SharedModel, String>)>;
+
+/// The checked synthesis model and radiation gains of every distinct bank
+/// (distinct `Arc`s), in object order.
+fn distinct_models(banks: &[Arc<ModeBank>]) -> DistinctModels {
+    let mut models = DistinctModels::new();
+    for (i, bank) in banks.iter().enumerate() {
+        if banks[..i].iter().any(|b| Arc::ptr_eq(b, bank)) {
+            continue;
+        }
+        let model = SynthModel::shared(Arc::clone(bank)).map_err(|e| e.to_string()).map(|model| {
+            let gains = radiation_gains(&model, bank);
+            (Arc::new(model), Arc::new(gains))
+        });
+        models.push((i, model));
+    }
+    models
+}
+
+/// Each object's model from `models`, `None` for objects never struck; a
+/// bank that cannot be synthesized is an error of its first struck object.
 fn shared_models(
     banks: &[Arc<ModeBank>],
     names: &[String],
     strikes: &[Vec<Strike>],
+    models: DistinctModels,
 ) -> Result<Vec<Option<SharedModel>>, SceneError> {
-    let mut models: Vec<(*const ModeBank, SharedModel)> = Vec::new();
     let mut per_object = Vec::with_capacity(banks.len());
     for (i, bank) in banks.iter().enumerate() {
         if strikes[i].is_empty() {
             per_object.push(None);
             continue;
         }
-        let key = Arc::as_ptr(bank);
-        let idx = match models.iter().position(|m| m.0 == key) {
-            Some(idx) => idx,
-            None => {
-                let model = SynthModel::shared(Arc::clone(bank)).map_err(|e| SceneError::Synthesis {
-                    object: names[i].clone(),
-                    message: e.to_string(),
-                })?;
-                let gains = radiation_gains(&model, bank);
-                models.push((key, (Arc::new(model), Arc::new(gains))));
-                models.len() - 1
+        let (_, model) = models
+            .iter()
+            .find(|(first, _)| Arc::ptr_eq(&banks[*first], bank))
+            .expect("distinct_models covers every bank");
+        match model {
+            Ok((model, gains)) => per_object.push(Some((Arc::clone(model), Arc::clone(gains)))),
+            Err(message) => {
+                return Err(SceneError::Synthesis { object: names[i].clone(), message: message.clone() })
             }
-        };
-        let (model, gains) = &models[idx].1;
-        per_object.push(Some((Arc::clone(model), Arc::clone(gains))));
+        }
     }
     Ok(per_object)
 }
