@@ -62,15 +62,20 @@ impl ModeBank {
     /// Reads, verifies (format, version, checksum, shapes) and validates the
     /// bank at `path`. Content errors do not repeat the path; I/O errors do.
     pub fn load(path: impl AsRef<Path>) -> Result<ModeBank, BankError> {
-        let path = path.as_ref();
-        let fast = std::fs::File::open(path)
-            .ok()
-            .filter(is_file)
-            .and_then(|mut f| crate::format::decode_file(&mut f));
-        match fast {
-            Some(bank) => Ok(bank),
-            // Anything unusual: the plain path gives the exact error.
-            None => ModeBank::from_bytes(&read_file(path)?),
-        }
+        read_bank(path.as_ref())?
+    }
+}
+
+/// Reads and decodes the bank file at `path`: the outer error is about
+/// reading the file (missing, not a file, I/O), the inner one about its
+/// content (format, checksum, validation). A regular file is read straight
+/// into the bank's buffers (`format::decode_file`); anything unusual takes
+/// [`read_file`] + [`ModeBank::from_bytes`], which give the exact error.
+pub(crate) fn read_bank(path: &Path) -> Result<Result<ModeBank, BankError>, BankError> {
+    let fast =
+        std::fs::File::open(path).ok().filter(is_file).and_then(|mut f| crate::format::decode_file(&mut f));
+    match fast {
+        Some(bank) => Ok(Ok(bank)),
+        None => Ok(ModeBank::from_bytes(&read_file(path)?)),
     }
 }
