@@ -18,7 +18,10 @@ mod pipeline;
 
 pub use key::cache_key;
 pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, SurfaceMeshing};
-pub use pipeline::{assemble_matrices, precompute, Assembled, Outcome, Request, Stage, TARGET_RESIDUAL};
+pub use pipeline::{
+    assemble_matrices, precompute, residual_floor_warning, Assembled, Outcome, Request, Stage,
+    TARGET_RESIDUAL,
+};
 
 /// Version of the numerical pipeline; part of every cache key, so changing
 /// anything that alters results must bump it.

@@ -209,7 +209,7 @@ pub const TARGET_RESIDUAL: f64 = 1e-8;
 /// modes of very fine or very thin meshes), so the user is never left with a
 /// silently weaker result. The frequencies stay accurate: for a symmetric
 /// problem the eigenvalue error is second order in the residual.
-fn residual_floor_warning(bank: &ModeBank) -> Option<String> {
+pub fn residual_floor_warning(bank: &ModeBank) -> Option<String> {
     let above: Vec<usize> =
         (0..bank.residuals.len()).filter(|&i| bank.residuals[i] > TARGET_RESIDUAL).collect();
     let worst = above.iter().map(|&i| bank.residuals[i]).fold(0.0, f64::max);
