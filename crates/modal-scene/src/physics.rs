@@ -109,6 +109,8 @@ pub(crate) struct World {
     rolling_m: Vec<f64>,
     /// Per object: scratch, normal impulse of the last step [N·s].
     normal_ns: Vec<f64>,
+    /// Per object: thinnest extent of its collider (rapier's CCD thickness) [m].
+    ccd_thickness_m: Vec<f32>,
     gravity: [f64; 3],
 }
 
@@ -198,9 +200,13 @@ impl World {
         world.integration_parameters.friction_model = FrictionModel::Coulomb;
         let mut bodies = Vec::with_capacity(banks.len());
         let mut sides = Vec::with_capacity(banks.len() + 1);
+        let mut ccd_thickness_m = Vec::with_capacity(banks.len());
         let mut shapes = ShapeCache::default();
         for (i, bank) in banks.iter().enumerate() {
             let (handle, side) = add_object(&mut world, &mut shapes, scene, i, bank)?;
+            let thinnest =
+                world.bodies[handle].colliders().iter().map(|c| world.colliders[*c].shape().ccd_thickness());
+            ccd_thickness_m.push(thinnest.fold(f32::INFINITY, f32::min));
             bodies.push(handle);
             sides.push(side);
         }
@@ -225,7 +231,16 @@ impl World {
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
         let normal_ns = vec![0.0; bodies.len()];
-        Ok(World { world, bodies, sides, pre_step, rolling_m, normal_ns, gravity: scene.gravity_m_s2 })
+        Ok(World {
+            world,
+            bodies,
+            sides,
+            pre_step,
+            rolling_m,
+            normal_ns,
+            ccd_thickness_m,
+            gravity: scene.gravity_m_s2,
+        })
     }
 
     /// World position of object `i`'s centre of mass [m].
@@ -251,7 +266,36 @@ impl World {
             let b = &self.world.bodies[*h];
             self.pre_step[i] = (d3(b.linvel()), d3(b.angvel()), d3(b.center_of_mass()));
         }
+        self.update_bullets();
         self.world.step();
+    }
+
+    /// Continuous collision detection (CCD) against other moving bodies for
+    /// the bodies that are fast this step.
+    ///
+    /// Rapier sweeps every fast dynamic body (one whose farthest point moves
+    /// more than half its thinnest extent in a step) against fixed geometry;
+    /// only a "bullet" (`ccd_enabled`) also sweeps dynamic bodies, and a
+    /// bullet never sweeps another bullet. Were every body a bullet, no two
+    /// dynamic bodies would ever be swept against each other (a fast ball
+    /// went through a decomposed bowl's wall, `tests/ccd.rs`). So a body is a
+    /// bullet exactly while it moves faster than a quarter of its thinnest
+    /// extent per step (before gravity acts, hence a margin below rapier's
+    /// half): a fast body sweeps the slow ones, which are not bullets. Two
+    /// fast bodies flying into each other still rely on contact prediction.
+    fn update_bullets(&mut self) {
+        let dt = self.world.integration_parameters.dt;
+        for (h, thickness) in self.bodies.iter().zip(&self.ccd_thickness_m) {
+            let b = &self.world.bodies[*h];
+            if !b.is_dynamic() || b.is_sleeping() {
+                continue;
+            }
+            let reach = b.linvel().length() + b.angvel().length() * b.mass_properties().max_extent();
+            let fast = reach * dt > 0.25 * thickness;
+            if fast != b.is_ccd_enabled() {
+                self.world.bodies[*h].enable_ccd(fast);
+            }
+        }
     }
 
     /// Every contact point that carried an impulse in the last step, pairs in
@@ -407,7 +451,6 @@ fn add_object(
             .linvel(v3(o.linear_velocity_m_s))
             .angvel(v3(o.angular_velocity_rad_s))
             .additional_mass_properties(props)
-            .ccd_enabled(true)
     } else {
         RigidBodyBuilder::fixed().pose(pose)
     };
