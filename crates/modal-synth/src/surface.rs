@@ -170,6 +170,11 @@ impl Aabb {
     }
 }
 
+/// Centre of a box.
+fn centroid(b: &Aabb) -> V3 {
+    [(b.min[0] + b.max[0]) * 0.5, (b.min[1] + b.max[1]) * 0.5, (b.min[2] + b.max[2]) * 0.5]
+}
+
 #[derive(Clone, Debug)]
 struct Node {
     bounds: Aabb,
@@ -227,12 +232,9 @@ impl SurfaceLocator {
         self.order.is_empty()
     }
 
-    fn centroid(&self, t: usize) -> V3 {
-        let b = &self.tri_bounds[t];
-        [(b.min[0] + b.max[0]) * 0.5, (b.min[1] + b.max[1]) * 0.5, (b.min[2] + b.max[2]) * 0.5]
-    }
-
     fn split(&mut self, root: usize) {
+        // Box centres once, not per comparison of the median selection.
+        let centroids: Vec<V3> = self.tri_bounds.iter().map(centroid).collect();
         let mut stack = vec![root];
         while let Some(ni) = stack.pop() {
             let Node { start, count, .. } = self.nodes[ni];
@@ -241,7 +243,7 @@ impl SurfaceLocator {
             }
             let mut cb = Aabb::EMPTY;
             for &t in &self.order[start..start + count] {
-                cb.grow(self.centroid(t));
+                cb.grow(centroids[t]);
             }
             let ext = sub(cb.max, cb.min);
             let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
@@ -252,11 +254,9 @@ impl SurfaceLocator {
                 2
             };
             let mid = count / 2;
-            let mut slice = std::mem::take(&mut self.order);
-            slice[start..start + count].select_nth_unstable_by(mid, |&a, &b| {
-                self.centroid(a)[axis].total_cmp(&self.centroid(b)[axis]).then(a.cmp(&b))
+            self.order[start..start + count].select_nth_unstable_by(mid, |&a, &b| {
+                centroids[a][axis].total_cmp(&centroids[b][axis]).then(a.cmp(&b))
             });
-            self.order = slice;
             let child = self.nodes.len();
             for (s, c) in [(start, mid), (start + mid, count - mid)] {
                 let mut b = Aabb::EMPTY;
