@@ -56,11 +56,48 @@ pub fn spmm(a: SparseColMatRef<'_, usize, f64>, x: MatRef<'_, f64>) -> Mat<f64> 
     y
 }
 
-/// C = Aᵀ B.
+/// Tall dense products with at least this many rows run as two parallel tasks.
+const SPLIT_MIN_ROWS: usize = 4096;
+
+/// Where the rows of a tall product are split: a fixed point that depends on the row count
+/// only, so the arithmetic (and the result, bit for bit) is the same for any thread count.
+fn row_split(n: usize) -> Option<usize> {
+    (n >= SPLIT_MIN_ROWS).then_some(n / 2)
+}
+
+/// C = Aᵀ B for tall A and B (n × a, n × b): the two halves of the rows are reduced as
+/// parallel tasks (each streams half of A and B) and added.
 pub fn tmul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let mut c = Mat::zeros(a.ncols(), b.ncols());
-    matmul(c.as_mut(), Accum::Replace, a.transpose(), b, 1.0, Par::Seq);
-    c
+    let seq = |a: MatRef<'_, f64>, b: MatRef<'_, f64>| {
+        let mut c = Mat::zeros(a.ncols(), b.ncols());
+        matmul(c.as_mut(), Accum::Replace, a.transpose(), b, 1.0, Par::Seq);
+        c
+    };
+    match row_split(a.nrows()) {
+        None => seq(a, b),
+        Some(h) => {
+            let (a0, a1) = a.split_at_row(h);
+            let (b0, b1) = b.split_at_row(h);
+            let (c0, c1) = rayon::join(|| seq(a0, b0), || seq(a1, b1));
+            c0 + c1
+        }
+    }
+}
+
+/// `out ← α·A·B` (`accum` Replace) or `out ← out + α·A·B` (Add) for a tall A (n × k) and a
+/// small B (k × m): the two halves of the rows run as parallel tasks.
+pub fn matmul_tall(out: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>, alpha: f64) {
+    match row_split(a.nrows()) {
+        None => matmul(out, accum, a, b, alpha, Par::Seq),
+        Some(h) => {
+            let (o0, o1) = out.split_at_row_mut(h);
+            let (a0, a1) = a.split_at_row(h);
+            rayon::join(
+                || matmul(o0, accum, a0, b, alpha, Par::Seq),
+                || matmul(o1, accum, a1, b, alpha, Par::Seq),
+            );
+        }
+    }
 }
 
 /// Deterministic SplitMix64 source of uniform numbers in (−1, 1).
@@ -123,7 +160,7 @@ impl Deflation {
             return;
         }
         let c = tmul(self.mv.as_ref(), z.rb());
-        matmul(z.rb_mut(), Accum::Add, self.v.as_ref(), c.as_ref(), -1.0, Par::Seq);
+        matmul_tall(z.rb_mut(), Accum::Add, self.v.as_ref(), c.as_ref(), -1.0);
     }
 }
 
@@ -169,9 +206,9 @@ pub fn svqb_with(mut z: MatMut<'_, f64>, mut mz: MatMut<'_, f64>, drop: f64) -> 
             }
         }
         let mut q = Mat::<f64>::zeros(z.nrows(), r);
-        matmul(q.as_mut(), Accum::Replace, zr, t.as_ref(), 1.0, Par::Seq);
+        matmul_tall(q.as_mut(), Accum::Replace, zr, t.as_ref(), 1.0);
         z.rb_mut().subcols_mut(0, r).copy_from(q.as_ref());
-        matmul(q.as_mut(), Accum::Replace, mz.rb().subcols(0, rank), t.as_ref(), 1.0, Par::Seq);
+        matmul_tall(q.as_mut(), Accum::Replace, mz.rb().subcols(0, rank), t.as_ref(), 1.0);
         mz.rb_mut().subcols_mut(0, r).copy_from(q.as_ref());
         let mut nb = Mat::<f64>::zeros(r, p);
         matmul(nb.as_mut(), Accum::Replace, bt.as_ref(), b_total.as_ref().subrows(0, rank), 1.0, Par::Seq);
@@ -210,7 +247,7 @@ pub fn orthogonalize(
         defl.project_out(z.rb_mut());
         if basis.ncols() > 0 {
             let c = tmul(mbasis, z.rb());
-            matmul(z.rb_mut(), Accum::Add, basis, c.as_ref(), -1.0, Par::Seq);
+            matmul_tall(z.rb_mut(), Accum::Add, basis, c.as_ref(), -1.0);
             coeffs += &c;
         }
     }
@@ -288,11 +325,11 @@ pub fn rayleigh_ritz_kM(
     let (lams, u) = sym_eig(kq.as_ref())
         .ok_or_else(|| crate::EigenError::Factorization("dense eigensolver failed".into()))?;
     let mut w = Mat::<f64>::zeros(n, q);
-    matmul(w.as_mut(), Accum::Replace, y.as_ref(), u.as_ref(), 1.0, Par::Seq);
+    matmul_tall(w.as_mut(), Accum::Replace, y.as_ref(), u.as_ref(), 1.0);
     let mut kw = Mat::<f64>::zeros(n, q);
-    matmul(kw.as_mut(), Accum::Replace, ky.as_ref(), u.as_ref(), 1.0, Par::Seq);
+    matmul_tall(kw.as_mut(), Accum::Replace, ky.as_ref(), u.as_ref(), 1.0);
     let mut mw = Mat::<f64>::zeros(n, q);
-    matmul(mw.as_mut(), Accum::Replace, my.as_ref(), u.as_ref(), 1.0, Par::Seq);
+    matmul_tall(mw.as_mut(), Accum::Replace, my.as_ref(), u.as_ref(), 1.0);
     let res = residuals_from(&lams, kw.as_ref(), mw.as_ref());
     Ok((lams, w, res))
 }

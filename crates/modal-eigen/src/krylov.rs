@@ -10,7 +10,9 @@
 //! `‖K y − λ M y‖₂ / (λ ‖M y‖₂)`, computed explicitly. Block size ≥ multiplicity finds
 //! exactly repeated eigenvalues directly; larger clusters are caught by the inertia check.
 
-use crate::block::{next_block, rayleigh_ritz_kM, residuals_from, spmm, sym_eig, Deflation, Rng};
+use crate::block::{
+    matmul_tall, next_block, rayleigh_ritz_kM, residuals_from, spmm, sym_eig, Deflation, Rng,
+};
 use crate::factor::ShiftedFactor;
 use crate::types::{EigenError, Progress};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -225,24 +227,16 @@ pub fn search(
         // Thick restart: keep the l best Ritz vectors plus the residual block.
         let l = ((cfg.nev + ncv) / 2).max(conv + p).min(ncv - p).min(k);
         let mut y = Mat::<f64>::zeros(n, l);
-        matmul(
-            y.as_mut(),
-            Accum::Replace,
-            v.as_ref().subcols(0, k),
-            ritz.s.as_ref().subcols(0, l),
-            1.0,
-            Par::Seq,
-        );
+        matmul_tall(y.as_mut(), Accum::Replace, v.as_ref().subcols(0, k), ritz.s.as_ref().subcols(0, l), 1.0);
         let resid = v.as_ref().subcols(k, p).to_owned();
         v.as_mut().subcols_mut(0, l).copy_from(y.as_ref());
         v.as_mut().subcols_mut(l, p).copy_from(resid.as_ref());
-        matmul(
+        matmul_tall(
             y.as_mut(),
             Accum::Replace,
             mv.as_ref().subcols(0, k),
             ritz.s.as_ref().subcols(0, l),
             1.0,
-            Par::Seq,
         );
         let mresid = mv.as_ref().subcols(k, p).to_owned();
         mv.as_mut().subcols_mut(0, l).copy_from(y.as_ref());
@@ -318,14 +312,7 @@ fn try_finish(
     // y' = A y / θ = V s + V_next E s / θ, whose residual ‖K y' − λ M y'‖ = ‖M r‖/θ² is not
     // amplified by K (the plain Ritz vector's residual is (K − σM) r / θ).
     let mut y = Mat::<f64>::zeros(v.nrows(), q);
-    matmul(
-        y.as_mut(),
-        Accum::Replace,
-        v.as_ref().subcols(0, k),
-        ritz.s.as_ref().subcols(0, q),
-        1.0,
-        Par::Seq,
-    );
+    matmul_tall(y.as_mut(), Accum::Replace, v.as_ref().subcols(0, k), ritz.s.as_ref().subcols(0, q), 1.0);
     let mut e = Mat::<f64>::zeros(p, q);
     matmul(
         e.as_mut(),
@@ -341,7 +328,7 @@ fn try_finish(
             e[(r, c)] *= inv;
         }
     }
-    matmul(y.as_mut(), Accum::Add, v.as_ref().subcols(k, p), e.as_ref(), 1.0, Par::Seq);
+    matmul_tall(y.as_mut(), Accum::Add, v.as_ref().subcols(k, p), e.as_ref(), 1.0);
     let (lambdas, y, res) = rayleigh_ritz_kM(k_mat, m, y)?;
     let worst = res
         .iter()
