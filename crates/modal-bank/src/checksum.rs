@@ -44,24 +44,63 @@ pub(crate) fn checksum<'a>(
     mut tensors: Vec<TensorBytes<'a>>,
     metadata: impl IntoIterator<Item = (&'a str, &'a str)>,
 ) -> String {
-    let mut h = Sha256::new();
-    put_bytes(&mut h, TAG.as_bytes());
+    let mut h = Hasher::new();
     tensors.sort_by(|a, b| a.name.cmp(b.name));
     for t in &tensors {
-        put_bytes(&mut h, t.name.as_bytes());
-        put_bytes(&mut h, t.dtype.as_bytes());
-        put_u64(&mut h, t.shape.len() as u64);
-        for &d in t.shape {
-            put_u64(&mut h, d as u64);
+        h.tensor(t);
+    }
+    h.finish(metadata)
+}
+
+/// The checksum fed step by step, for callers that hash a tensor's data in
+/// pieces as they arrive: [`Hasher::new`], then per tensor in name order
+/// either [`Hasher::tensor`] or [`Hasher::tensor_header`] followed by
+/// [`Hasher::data`] pieces totalling the announced length, then
+/// [`Hasher::finish`]. The bytes hashed are exactly those of [`checksum`].
+pub(crate) struct Hasher(Sha256);
+
+impl Hasher {
+    /// Starts with the domain tag.
+    pub fn new() -> Hasher {
+        let mut h = Sha256::new();
+        put_bytes(&mut h, TAG.as_bytes());
+        Hasher(h)
+    }
+
+    /// One whole tensor.
+    pub fn tensor(&mut self, t: &TensorBytes<'_>) {
+        self.tensor_header(t.name, &t.dtype, t.shape, t.data.len());
+        self.data(t.data);
+    }
+
+    /// A tensor's name, dtype, shape and data length; its `len` data bytes
+    /// follow through [`Hasher::data`].
+    pub fn tensor_header(&mut self, name: &str, dtype: &str, shape: &[usize], len: usize) {
+        let h = &mut self.0;
+        put_bytes(h, name.as_bytes());
+        put_bytes(h, dtype.as_bytes());
+        put_u64(h, shape.len() as u64);
+        for &d in shape {
+            put_u64(h, d as u64);
         }
-        put_bytes(&mut h, t.data);
+        put_u64(h, len as u64);
     }
-    let mut entries: Vec<_> =
-        metadata.into_iter().filter(|(k, _)| *k != crate::format::KEY_CHECKSUM).collect();
-    entries.sort();
-    for (k, v) in entries {
-        put_bytes(&mut h, k.as_bytes());
-        put_bytes(&mut h, v.as_bytes());
+
+    /// The next piece of the current tensor's data.
+    pub fn data(&mut self, bytes: &[u8]) {
+        self.0.update(bytes);
     }
-    to_hex(&h.finalize())
+
+    /// Hashes the metadata entries (sorted, `checksum` skipped) and returns
+    /// the lowercase hex digest.
+    pub fn finish<'a>(mut self, metadata: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+        let mut entries: Vec<_> =
+            metadata.into_iter().filter(|(k, _)| *k != crate::format::KEY_CHECKSUM).collect();
+        entries.sort();
+        for (k, v) in entries {
+            put_bytes(&mut self.0, k.as_bytes());
+            put_bytes(&mut self.0, v.as_bytes());
+        }
+        to_hex(&self.0.finalize())
+    }
 }
