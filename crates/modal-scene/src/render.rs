@@ -5,7 +5,9 @@
 //! 2. **physics + excitation**: fixed-rate rapier steps; after each step the
 //!    contacts become strikes ([`crate::excite`]); trajectories are kept for
 //!    the listener; once every body sleeps the remaining steps are skipped;
-//! 3. **synthesis**: one [`modal_synth::ModalVoice`] per object that was
+//! 3. **synthesis**: the checked model and radiation gains of each distinct
+//!    bank are built on the second core while the physics runs; then one
+//!    [`modal_synth::ModalVoice`] per object that was
 //!    struck (objects never hit cost nothing), in parallel over objects, each
 //!    rendered from its first strike until, with no strike pending, a block
 //!    of it as heard from the object's nearest point to an ear is
