@@ -101,7 +101,12 @@ impl PipelineProvider<'_> {
         let placeholder = TetMesh { nodes: Vec::new(), cells: Cells::Tet4(Vec::new()), groups: Vec::new() };
         let source = MeshSource::Memory { mesh: placeholder, identity: identity.to_string() };
         let key = modal_precompute::cache_key(&self.request(request, material.clone(), source))?;
-        let Ok(Some(bank)) = cache.get(&key) else { return Ok(None) };
+        // Read like any bank file (straight into the bank's buffers); a
+        // missing, damaged or foreign entry is left to the pipeline.
+        let Ok(bank) = ModeBank::load(cache.path_for(&key)?) else { return Ok(None) };
+        if bank.info.input_hash != key {
+            return Ok(None);
+        }
         self.warnings.extend(residual_floor_warning(&bank).map(|w| format!("{what}: {w}")));
         self.cached += 1;
         Ok(Some(Arc::new(bank)))
