@@ -7,7 +7,7 @@
 //! concurrent writers of one key are safe and readers never see partial files.
 //! A damaged entry is reported as [`BankError::CorruptCacheEntry`], never served.
 
-use crate::fsio::{atomic_write, read_file};
+use crate::fsio::{atomic_write, read_bank};
 use crate::{BankError, ModeBank};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -51,7 +51,7 @@ impl BankCache {
     /// written for another key (warn, recompute, `put` over it).
     pub fn get(&self, key: &str) -> Result<Option<ModeBank>, BankError> {
         let path = self.path_for(key)?;
-        let bytes = match read_file(&path) {
+        let loaded = match read_bank(&path) {
             Ok(b) => b,
             Err(BankError::Read { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
                 return Ok(None)
@@ -59,7 +59,7 @@ impl BankCache {
             Err(e) => return Err(e),
         };
         let corrupt = |reason| BankError::CorruptCacheEntry { path: path.clone(), reason: Box::new(reason) };
-        let bank = ModeBank::from_bytes(&bytes).map_err(corrupt)?;
+        let bank = loaded.map_err(corrupt)?;
         if bank.info.input_hash != key {
             return Err(corrupt(BankError::KeyMismatch { key: key.into(), found: bank.info.input_hash }));
         }
