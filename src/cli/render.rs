@@ -107,25 +107,12 @@ impl PipelineProvider<'_> {
         if bank.info.input_hash != key {
             return Ok(None);
         }
-        self.warnings.extend(residual_floor_warning(&bank).map(|w| format!("{what}: {w}")));
+        // The same warning the pipeline gives for a bank it serves from the cache.
+        let warning = modal_precompute::residual_floor_warning(&bank);
+        self.warnings.extend(warning.map(|w| format!("{what}: {w}")));
         self.cached += 1;
         Ok(Some(Arc::new(bank)))
     }
-}
-
-/// The warning the pipeline gives for a cached bank whose residuals stay
-/// above [`modal_precompute::TARGET_RESIDUAL`].
-fn residual_floor_warning(bank: &ModeBank) -> Option<String> {
-    let above = bank.residuals.iter().filter(|&&r| r > modal_precompute::TARGET_RESIDUAL).count();
-    let worst = bank.residuals.iter().copied().fold(0.0, f64::max);
-    (above > 0).then(|| {
-        format!(
-            "{above} of {} modes have residuals up to {worst:.1e} > {:.0e}: the limit of double precision \
-             for this mesh; the frequencies stay accurate",
-            bank.residuals.len(),
-            modal_precompute::TARGET_RESIDUAL
-        )
-    })
 }
 
 fn describe(mesh: &modal_scene::MeshSource) -> String {
