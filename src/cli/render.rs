@@ -101,12 +101,8 @@ impl PipelineProvider<'_> {
         let placeholder = TetMesh { nodes: Vec::new(), cells: Cells::Tet4(Vec::new()), groups: Vec::new() };
         let source = MeshSource::Memory { mesh: placeholder, identity: identity.to_string() };
         let key = modal_precompute::cache_key(&self.request(request, material.clone(), source))?;
-        // Read like any bank file (straight into the bank's buffers); a
-        // missing, damaged or foreign entry is left to the pipeline.
-        let Ok(bank) = ModeBank::load(cache.path_for(&key)?) else { return Ok(None) };
-        if bank.info.input_hash != key {
-            return Ok(None);
-        }
+        // A missing, damaged or foreign entry is left to the pipeline.
+        let Ok(Some(bank)) = cache.get(&key) else { return Ok(None) };
         // The same warning the pipeline gives for a bank it serves from the cache.
         let warning = modal_precompute::residual_floor_warning(&bank);
         self.warnings.extend(warning.map(|w| format!("{what}: {w}")));
