@@ -10,6 +10,11 @@
 //! reused for every shift, shift-invert around a shift scaled to the problem, restarted block
 //! Krylov–Schur in the M-inner product with explicit rigid-mode deflation
 //! (see [`solve`] and the module docs of `krylov`, `factor`, `ordering`).
+//!
+//! Reproducibility: for a given build and CPU the result is bit-identical whatever the
+//! thread count (parallel work is split at fixed points). Any change here that alters results,
+//! even in the last bit, must bump `modal_precompute::SOLVER_VERSION` (cached banks would
+//! otherwise differ from fresh solves, and scenes promise the same WAV either way).
 
 mod block;
 mod factor;

@@ -24,8 +24,12 @@ pub use pipeline::{
 };
 
 /// Version of the numerical pipeline; part of every cache key, so changing
-/// anything that alters results must bump it.
-pub const SOLVER_VERSION: &str = "modal-precompute-1";
+/// anything that alters results — even in the last bit, e.g. the order of a
+/// sum in the eigensolver — must bump it: scenes promise the same WAV whether
+/// a bank came from the cache or from a fresh solve, and the basis chosen
+/// within a repeated eigenvalue follows every rounding.
+/// History: 2 — session 3's parallel sparse/dense products in modal-eigen.
+pub const SOLVER_VERSION: &str = "modal-precompute-2";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]
