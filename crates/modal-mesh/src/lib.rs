@@ -23,6 +23,7 @@
 //! Errors are [`MeshError`] values whose message is one line naming the
 //! file position, element or node; nothing here panics on user data.
 
+mod closest;
 mod error;
 mod measure;
 mod overlap;
@@ -35,6 +36,7 @@ mod validate;
 pub mod generate;
 pub mod io;
 
+pub use closest::closest_point_on_triangle;
 pub use error::{Location, MeshError};
 pub use io::{read_mesh, write_msh41, write_msh41_file};
 pub use measure::{mesh_volume, tet_volume};

@@ -69,48 +69,9 @@ pub fn dihedral_angles_deg(p: [V3; 4]) -> [f64; 6] {
     })
 }
 
-/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision
-/// Detection, §5.1.5).
+/// Closest point on triangle (a, b, c) to p ([`modal_mesh::closest_point_on_triangle`]).
 pub fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return lerp(a, b, d1 / (d1 - d3));
-    }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return lerp(a, c, d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = va + vb + vc;
-    if denom.abs() < f64::MIN_POSITIVE {
-        return a;
-    }
-    let v = vb / denom;
-    let w = vc / denom;
-    add(a, add(scale(ab, v), scale(ac, w)))
+    modal_mesh::closest_point_on_triangle(p, a, b, c).0
 }
 
 /// Parameter t ∈ [0, 1] where segment p→q crosses triangle (a, b, c), if it
