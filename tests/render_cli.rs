@@ -48,6 +48,25 @@ fn identical_assets_are_solved_once_and_both_sound() {
     let second = modal(dir.path(), &args).ok().json();
     assert_eq!(second["banks_cached"], 1);
     assert_eq!(std::fs::read(dir.path().join("s.wav")).unwrap(), wav);
+
+    // A cache entry damaged inside its mode shapes passes the first step of a
+    // deferred load (surface and mass) and fails its checksum while the physics
+    // runs: the render starts over through the plain path, which reports the
+    // entry, solves again and replaces it; the WAV is still the same.
+    let entries: Vec<_> =
+        std::fs::read_dir(dir.path().join("cache")).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    let mut bytes = std::fs::read(&entries[0]).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x10;
+    std::fs::write(&entries[0], &bytes).unwrap();
+    let third = modal(dir.path(), &args).ok();
+    assert!(third.stderr.contains("checksum mismatch"), "{}", third.stderr);
+    let third = third.json();
+    assert_eq!((third["banks_cached"].as_u64(), third["banks_solved"].as_u64()), (Some(0), Some(1)));
+    assert_eq!(std::fs::read(dir.path().join("s.wav")).unwrap(), wav);
+    let fourth = modal(dir.path(), &args).ok().json();
+    assert_eq!(fourth["banks_cached"], 1);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! scene and write what its listener hears.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
@@ -9,7 +10,7 @@ use modal_bank::{BankCache, ModeBank};
 use modal_fem::Material;
 use modal_mesh::{Cells, TetMesh};
 use modal_precompute::{MeshSource, Request};
-use modal_scene::{BankProvider, BankRequest, ProviderError, Scene};
+use modal_scene::{BankProvider, BankRequest, ProvidedBank, ProviderError, Scene};
 use modal_synth::WavFormat;
 
 use super::args::RenderArgs;
@@ -31,6 +32,11 @@ struct PipelineProvider<'a> {
     /// Assets served from the cache and solved fresh.
     cached: usize,
     solved: usize,
+    /// Serve cached banks in two steps (surface and mass first, the shapes
+    /// verified while the physics runs).
+    defer: bool,
+    /// Set when a deferred entry failed its verification.
+    deferred_failed: Arc<AtomicBool>,
 }
 
 impl BankProvider for PipelineProvider<'_> {
@@ -44,10 +50,7 @@ impl BankProvider for PipelineProvider<'_> {
         let source = match mesh {
             modal_scene::MeshSource::File(path) => MeshSource::File(path.clone()),
             modal_scene::MeshSource::Generate(spec) => {
-                let shape = spec.shape()?;
-                let order = request.order.unwrap_or(2);
-                let h = spec.element_size.unwrap_or_else(|| shape.default_element_size(order));
-                let identity = format!("generated {shape:?} h={h:e}");
+                let (shape, h, order, identity) = recipe(spec, request)?;
                 // The cache key of a generated mesh is its recipe: a cached
                 // bank is served without generating the mesh at all.
                 if let Some(bank) = self.cached_generated(request, &material, &identity, &what)? {
@@ -70,6 +73,28 @@ impl BankProvider for PipelineProvider<'_> {
         }
         Ok(Arc::new(outcome.bank))
     }
+
+    fn provide(&mut self, request: &BankRequest) -> Result<ProvidedBank, ProviderError> {
+        if self.defer {
+            if let Some(pending) = self.cached_generated_deferred(request)? {
+                return Ok(pending);
+            }
+        }
+        self.bank(request).map(ProvidedBank::Ready)
+    }
+}
+
+/// A generator recipe resolved: shape, element size, order and the identity
+/// that keys its bank in the cache.
+fn recipe(
+    spec: &modal_scene::GeneratorSpec,
+    request: &BankRequest,
+) -> Result<(modal_mesh::generate::Shape, f64, u8, String), ProviderError> {
+    let shape = spec.shape()?;
+    let order = request.order.unwrap_or(2);
+    let h = spec.element_size.unwrap_or_else(|| shape.default_element_size(order));
+    let identity = format!("generated {shape:?} h={h:e}");
+    Ok((shape, h, order, identity))
 }
 
 impl PipelineProvider<'_> {
@@ -84,12 +109,32 @@ impl PipelineProvider<'_> {
         pipeline
     }
 
+    /// The cache key of the bank of a generated mesh named by `identity`
+    /// (the key reads only the identity of an in-memory mesh, so an empty
+    /// mesh stands in for the one not generated).
+    fn generated_key(
+        &self,
+        request: &BankRequest,
+        material: &Material,
+        identity: &str,
+    ) -> Result<String, ProviderError> {
+        let placeholder = TetMesh { nodes: Vec::new(), cells: Cells::Tet4(Vec::new()), groups: Vec::new() };
+        let source = MeshSource::Memory { mesh: placeholder, identity: identity.to_string() };
+        Ok(modal_precompute::cache_key(&self.request(request, material.clone(), source))?)
+    }
+
+    /// Counts a bank served from the cache and gives the warning the pipeline
+    /// gives for one.
+    fn served_from_cache(&mut self, bank: &ModeBank, what: &str) {
+        let warning = modal_precompute::residual_floor_warning(bank);
+        self.warnings.extend(warning.map(|w| format!("{what}: {w}")));
+        self.cached += 1;
+    }
+
     /// The cached bank of a generated mesh named by `identity` (`what` in
-    /// messages), looked up by
-    /// its cache key (which reads only the identity of an in-memory mesh, so
-    /// an empty mesh stands in for the one not generated). `None` when there
-    /// is no cache or no valid entry: the caller then runs the pipeline,
-    /// which reports a damaged entry and recomputes it.
+    /// messages), looked up by its cache key. `None` when there is no cache
+    /// or no valid entry: the caller then runs the pipeline, which reports a
+    /// damaged entry and recomputes it.
     fn cached_generated(
         &mut self,
         request: &BankRequest,
@@ -98,16 +143,38 @@ impl PipelineProvider<'_> {
         what: &str,
     ) -> Result<Option<Arc<ModeBank>>, ProviderError> {
         let Some(cache) = &self.cache else { return Ok(None) };
-        let placeholder = TetMesh { nodes: Vec::new(), cells: Cells::Tet4(Vec::new()), groups: Vec::new() };
-        let source = MeshSource::Memory { mesh: placeholder, identity: identity.to_string() };
-        let key = modal_precompute::cache_key(&self.request(request, material.clone(), source))?;
+        let key = self.generated_key(request, material, identity)?;
         // A missing, damaged or foreign entry is left to the pipeline.
         let Ok(Some(bank)) = cache.get(&key) else { return Ok(None) };
-        // The same warning the pipeline gives for a bank it serves from the cache.
-        let warning = modal_precompute::residual_floor_warning(&bank);
-        self.warnings.extend(warning.map(|w| format!("{what}: {w}")));
-        self.cached += 1;
+        self.served_from_cache(&bank, what);
         Ok(Some(Arc::new(bank)))
+    }
+
+    /// [`Self::cached_generated`] in two steps: the bank without its shapes
+    /// now, the shapes read and the entry verified while the physics runs. A
+    /// failed verification sets `deferred_failed` (the render then fails and
+    /// `run` renders again through the plain path).
+    fn cached_generated_deferred(
+        &mut self,
+        request: &BankRequest,
+    ) -> Result<Option<ProvidedBank>, ProviderError> {
+        let (Some(cache), Some(modal_scene::MeshSource::Generate(spec)), Some(material)) =
+            (&self.cache, &request.mesh, &request.material)
+        else {
+            return Ok(None);
+        };
+        let (_, _, _, identity) = recipe(spec, request)?;
+        let key = self.generated_key(request, material, &identity)?;
+        let Ok(Some((light, rest))) = cache.get_deferred(&key) else { return Ok(None) };
+        self.served_from_cache(&light, &describe(request.mesh.as_ref().ok_or("no mesh")?));
+        let failed = Arc::clone(&self.deferred_failed);
+        let rest = Box::new(move || {
+            rest.finish().map_err(|e| {
+                failed.store(true, Ordering::SeqCst);
+                ProviderError::from(e)
+            })
+        });
+        Ok(Some(ProvidedBank::Pending { light: Box::new(light), rest }))
     }
 }
 
@@ -139,9 +206,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
         warnings: Vec::new(),
         cached: 0,
         solved: 0,
+        defer: true,
+        deferred_failed: Arc::new(AtomicBool::new(false)),
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
-    let rendered = modal_scene::render(&scene, &mut provider, &options);
+    let mut rendered = modal_scene::render(&scene, &mut provider, &options);
+    if rendered.is_err() && provider.deferred_failed.load(Ordering::SeqCst) {
+        // A cached entry failed its checksum after the physics had started
+        // from its surface: render again through the plain path, which
+        // reports the entry, recomputes the bank and replaces the entry.
+        provider.defer = false;
+        (provider.cached, provider.solved) = (0, 0);
+        provider.warnings.clear();
+        rendered = modal_scene::render(&scene, &mut provider, &options);
+    }
     spinner.set("writing");
     let (warnings, cached, solved) =
         (std::mem::take(&mut provider.warnings), provider.cached, provider.solved);

@@ -8,6 +8,7 @@
 //! A damaged entry is reported as [`BankError::CorruptCacheEntry`], never served.
 
 use crate::fsio::{atomic_write, read_bank};
+use crate::DeferredBank;
 use crate::{BankError, ModeBank};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -64,6 +65,23 @@ impl BankCache {
             return Err(corrupt(BankError::KeyMismatch { key: key.into(), found: bank.info.input_hash }));
         }
         Ok(Some(bank))
+    }
+
+    /// [`Self::get`] in two steps (see [`DeferredBank`]): `Ok(None)` when there
+    /// is no entry; otherwise the light bank (no shapes, not yet verified) and
+    /// the pending rest, whose [`DeferredBank::finish`] verifies everything and
+    /// reports a damaged entry as [`BankError::CorruptCacheEntry`].
+    pub fn get_deferred(&self, key: &str) -> Result<Option<(ModeBank, DeferredBank)>, BankError> {
+        let path = self.path_for(key)?;
+        let file = match std::fs::File::open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(source) => return Err(BankError::Read { path, source }),
+        };
+        if !file.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(BankError::NotAFile { path });
+        }
+        DeferredBank::open(file, path, key).map(Some)
     }
 
     /// Stores `bank` under `key` atomically, replacing any previous entry.

@@ -20,6 +20,7 @@
 mod cache;
 mod checksum;
 mod damping;
+mod deferred;
 mod error;
 mod format;
 mod fsio;
@@ -35,6 +36,7 @@ pub use retune::{retune, RetuneSpec, RETUNED_PREFIX};
 pub use vtu::{export_vtu, export_vtu_file, mode_array_name};
 
 pub use damping::rayleigh;
+pub use deferred::DeferredBank;
 pub use error::BankError;
 pub use format::{FORMAT_NAME, FORMAT_VERSION};
 pub use types::*;

@@ -158,3 +158,37 @@ fn default_dir_precedence() {
     assert_eq!(default_dir_from(None, os("relative"), os("/h")).unwrap(), PathBuf::from("/h/.cache/modal"));
     assert!(matches!(default_dir_from(None, None, None), Err(BankError::NoCacheDir)));
 }
+
+#[test]
+fn deferred_entries_give_the_light_bank_first_and_the_same_bank_or_error_at_the_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = BankCache::new(dir.path());
+    let k = key(6);
+    assert!(cache.get_deferred(&k).unwrap().is_none());
+    let bank = bank_for(&k);
+    cache.put(&k, &bank).unwrap();
+    let (light, rest) = cache.get_deferred(&k).unwrap().unwrap();
+    assert!(light.shapes.is_empty());
+    assert_eq!(ModeBank { shapes: bank.shapes.clone(), ..light }, bank);
+    assert_eq!(rest.finish().unwrap(), bank);
+
+    // A flipped bit inside the data passes step 1 and is caught by step 2.
+    let path = cache.path_for(&k).unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x40;
+    std::fs::write(&path, &bytes).unwrap();
+    let (_, rest) = cache.get_deferred(&k).unwrap().unwrap();
+    let err = rest.finish().unwrap_err();
+    assert!(err.is_corrupt_cache_entry() && err.to_string().contains("checksum mismatch"), "{err}");
+    // A truncated entry or one filed under another key fails at step 1.
+    std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+    assert!(cache.get_deferred(&k).unwrap_err().is_corrupt_cache_entry());
+    let other = key(7);
+    cache.put(&k, &bank).unwrap();
+    std::fs::copy(&path, cache.path_for(&other).unwrap()).unwrap();
+    let err = cache.get_deferred(&other).unwrap_err();
+    assert!(
+        matches!(&err, BankError::CorruptCacheEntry { reason, .. } if matches!(**reason, BankError::KeyMismatch { .. }))
+    );
+}

@@ -43,7 +43,9 @@ pub use output::{
     write_events_json, write_spectrogram_png, write_wav, SPECTROGRAM_RANGE_DB, SPECTROGRAM_WINDOW,
 };
 pub use physics::{ContactSide, ROLLING_LOAD_CAP, SLEEP_AFTER_S};
-pub use provider::{BankProvider, BankRequest, InMemoryProvider, ProviderError};
+pub use provider::{
+    BankCompletion, BankProvider, BankRequest, InMemoryProvider, ProvidedBank, ProviderError,
+};
 pub use render::{
     render, ObjectReport, RenderOptions, RenderReport, Rendered, AIR_IMPEDANCE_PA_S_M, FADE_OUT_S,
     FULL_SCALE_PA, SILENCE_DB,

@@ -48,6 +48,26 @@ impl BankRequest {
 /// The provider's error type: anything printable.
 pub type ProviderError = Box<dyn std::error::Error + Send + Sync>;
 
+/// The work that completes a [`ProvidedBank::Pending`] bank.
+pub type BankCompletion = Box<dyn FnOnce() -> Result<ModeBank, ProviderError> + Send>;
+
+/// A bank as a provider hands it over.
+pub enum ProvidedBank {
+    /// The complete bank.
+    Ready(Arc<ModeBank>),
+    /// Everything but the mode shapes (`light.shapes` is empty), not yet
+    /// verified, and the work that completes and verifies it. The render runs
+    /// that work on the second core while the physics — which needs only the
+    /// surface, mass and material — runs; if it fails, the render fails before
+    /// any output exists.
+    Pending {
+        /// The bank without its shapes.
+        light: Box<ModeBank>,
+        /// Reads, verifies and returns the complete bank.
+        rest: BankCompletion,
+    },
+}
+
 /// Supplies mode banks (precompute + cache in the application, in-memory
 /// banks in tests). The bank's `mass` and `surface` define the rigid body;
 /// its `material` is used for Hertz contact.
@@ -55,6 +75,13 @@ pub trait BankProvider {
     /// The bank for one distinct asset. Called at most once per distinct
     /// request during a render.
     fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError>;
+
+    /// [`Self::bank`], or a bank whose shapes are still to be loaded (see
+    /// [`ProvidedBank::Pending`]). The render calls this one; the default
+    /// serves [`Self::bank`].
+    fn provide(&mut self, request: &BankRequest) -> Result<ProvidedBank, ProviderError> {
+        self.bank(request).map(ProvidedBank::Ready)
+    }
 }
 
 /// A provider serving fixed banks by generator name or file name, for tests
@@ -102,34 +129,93 @@ impl BankProvider for InMemoryProvider {
     }
 }
 
-/// Asks the provider once per distinct request; returns one bank per object
-/// and the number of provider calls.
+/// The banks of a scene's objects: complete or light (see [`ProvidedBank`]).
+pub(crate) struct ResolvedBanks {
+    /// One bank per object (identical assets share one `Arc`); light banks
+    /// have no shapes yet.
+    pub light: Vec<Arc<ModeBank>>,
+    /// Distinct assets asked for.
+    pub requested: usize,
+    /// Per object, its distinct asset.
+    asset_of: Vec<usize>,
+    /// Per distinct asset, the work completing it (`None`: already complete)
+    /// and the object path for errors.
+    completions: Vec<(Option<BankCompletion>, String)>,
+}
+
+impl ResolvedBanks {
+    /// The complete banks, one per object, sharing as the light ones do.
+    pub fn complete(self) -> Result<Vec<Arc<ModeBank>>, SceneError> {
+        let mut full = Vec::with_capacity(self.completions.len());
+        for (asset, (rest, path)) in self.completions.into_iter().enumerate() {
+            let first = self.asset_of.iter().position(|&a| a == asset).unwrap_or(0);
+            full.push(match rest {
+                None => Arc::clone(&self.light[first]),
+                Some(rest) => {
+                    let bank = rest().map_err(|source| SceneError::Bank { path: path.clone(), source })?;
+                    check_bank(&path, &bank)?;
+                    Arc::new(bank)
+                }
+            });
+        }
+        Ok(self.asset_of.iter().map(|&a| Arc::clone(&full[a])).collect())
+    }
+}
+
+/// Asks the provider once per distinct request; returns one bank per object.
 pub(crate) fn resolve_banks(
     scene: &Scene,
     provider: &mut dyn BankProvider,
-) -> Result<(Vec<Arc<ModeBank>>, usize), SceneError> {
-    let mut distinct: Vec<(BankRequest, Arc<ModeBank>)> = Vec::new();
-    let mut banks = Vec::with_capacity(scene.objects.len());
+) -> Result<ResolvedBanks, SceneError> {
+    let mut requests: Vec<BankRequest> = Vec::new();
+    let mut distinct: Vec<Arc<ModeBank>> = Vec::new();
+    let mut completions = Vec::new();
+    let mut asset_of = Vec::with_capacity(scene.objects.len());
     for (i, object) in scene.objects.iter().enumerate() {
         let path = format!("objects[{i}]");
         let request = BankRequest::for_object(scene, object)
             .map_err(|m| SceneError::invalid(format!("{path}.material"), m))?;
-        if let Some((_, bank)) = distinct.iter().find(|(r, _)| *r == request) {
-            banks.push(Arc::clone(bank));
+        if let Some(a) = requests.iter().position(|r| *r == request) {
+            asset_of.push(a);
             continue;
         }
-        let bank =
-            provider.bank(&request).map_err(|source| SceneError::Bank { path: path.clone(), source })?;
-        check_bank(&path, &bank)?;
-        distinct.push((request, Arc::clone(&bank)));
-        banks.push(bank);
+        let provided =
+            provider.provide(&request).map_err(|source| SceneError::Bank { path: path.clone(), source })?;
+        let (bank, rest) = match provided {
+            ProvidedBank::Ready(bank) => {
+                check_bank(&path, &bank)?;
+                (bank, None)
+            }
+            ProvidedBank::Pending { light, rest } => {
+                check_body(&path, &light)?;
+                (Arc::from(light), Some(rest))
+            }
+        };
+        asset_of.push(distinct.len());
+        requests.push(request);
+        distinct.push(bank);
+        completions.push((rest, path));
     }
-    Ok((banks, distinct.len()))
+    let light = asset_of.iter().map(|&a| Arc::clone(&distinct[a])).collect();
+    Ok(ResolvedBanks { light, requested: distinct.len(), asset_of, completions })
 }
 
 /// The scene relies on a bank's surface and mass properties; reject banks it
 /// cannot use instead of panicking later.
 fn check_bank(path: &str, bank: &ModeBank) -> Result<(), SceneError> {
+    check_body(path, bank)?;
+    let n = bank.surface.positions.len();
+    if bank.shapes.len() != bank.mode_count() * n * 3
+        || bank.decay_rates.len() != bank.mode_count()
+        || bank.damping_ratios.len() != bank.mode_count()
+    {
+        return Err(SceneError::invalid(path, "unusable bank: its arrays disagree in length"));
+    }
+    Ok(())
+}
+
+/// What the rigid body needs of a bank: a surface and sane mass properties.
+fn check_body(path: &str, bank: &ModeBank) -> Result<(), SceneError> {
     let bad = |m: &str| Err(SceneError::invalid(path, format!("unusable bank: {m}")));
     let n = bank.surface.positions.len();
     if n < 4 || bank.surface.triangles.is_empty() {
@@ -147,12 +233,6 @@ fn check_bank(path: &str, bank: &ModeBank) -> Result<(), SceneError> {
     }
     if m.center_of_mass_m.iter().chain(m.inertia_kg_m2.iter().flatten()).any(|x| !x.is_finite()) {
         return bad("its centre of mass or inertia is not finite");
-    }
-    if bank.shapes.len() != bank.mode_count() * n * 3
-        || bank.decay_rates.len() != bank.mode_count()
-        || bank.damping_ratios.len() != bank.mode_count()
-    {
-        return bad("its arrays disagree in length");
     }
     Ok(())
 }

@@ -105,7 +105,9 @@ pub struct RenderReport {
     pub physics_steps: usize,
     /// Total impacts.
     pub impacts: usize,
-    /// Seconds getting banks.
+    /// Seconds getting banks before the physics can start (solves, cache
+    /// look-ups; the shapes of cached banks are then read and verified on the
+    /// second core while the physics runs, see [`crate::ProvidedBank`]).
     pub banks_s: f64,
     /// Seconds building bodies and colliders (convex hulls, decompositions).
     pub colliders_s: f64,
@@ -168,16 +170,26 @@ pub fn render(
         ..Default::default()
     };
     let t = Instant::now();
-    let (banks, requested) = resolve_banks(scene, provider)?;
-    report.banks_requested = requested;
+    let resolved = resolve_banks(scene, provider)?;
+    report.banks_requested = resolved.requested;
     report.banks_s = t.elapsed().as_secs_f64();
-    check_ground_clearance(original, &banks[..original.objects.len()])?;
+    let light = resolved.light.clone();
+    check_ground_clearance(original, &light[..original.objects.len()])?;
 
     let names: Vec<String> = (0..scene.objects.len()).map(|i| scene.object_name(i)).collect();
-    // The synthesis models do not depend on the physics: they are built on
-    // the second core while the (single-threaded) physics runs.
-    let (sim, models) =
-        rayon::join(|| simulate(scene, &banks, &names, opts, &mut report), || distinct_models(&banks));
+    // The physics needs only each bank's surface, mass and material. Banks
+    // whose shapes are still pending are completed (read, checksummed,
+    // validated), and the synthesis models built, on the second core while
+    // the (single-threaded) physics runs.
+    let (sim, completed) = rayon::join(
+        || simulate(scene, &light, &names, opts, &mut report),
+        || {
+            let banks = resolved.complete()?;
+            let models = distinct_models(&banks);
+            Ok::<_, SceneError>((banks, models))
+        },
+    );
+    let (banks, models) = completed?;
     let sim = sim?;
 
     let t = Instant::now();

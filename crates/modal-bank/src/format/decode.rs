@@ -304,6 +304,17 @@ pub(super) fn from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
     })
 }
 
+/// Every field but `shapes` (left empty) of a bank file held in memory, checked for
+/// framing, format, dtypes and tensor shapes but **not** for the checksum nor by
+/// [`ModeBank::validate`]: for a caller that starts work on the surface and mass while
+/// [`from_bytes`] verifies the whole file (`crate::DeferredBank`).
+pub(super) fn light_from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
+    let (header, data) = read_header(bytes)?;
+    let meta = check_format(header.metadata().as_ref())?;
+    let raw = raw_tensors(&header, Region::whole(data))?;
+    bank_without_shapes(&Tensors(raw), meta)
+}
+
 /// Verifies the checksum on one thread while the other decodes the bank's
 /// fields but `shapes` and hands them to `finish`; a checksum mismatch is
 /// reported before any other error.

@@ -59,6 +59,11 @@ pub(crate) fn decode_file(file: &mut std::fs::File) -> Option<ModeBank> {
     decode::from_file(file)
 }
 
+/// Every field of a bank file but `shapes`, unverified (see `decode::light_from_bytes`).
+pub(crate) fn decode_light(bytes: &[u8]) -> Result<ModeBank, BankError> {
+    decode::light_from_bytes(bytes)
+}
+
 impl ModeBank {
     /// Encodes the bank as a safetensors file in memory (validates first).
     pub fn to_bytes(&self) -> Result<Vec<u8>, BankError> {
