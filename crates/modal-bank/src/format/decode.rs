@@ -118,8 +118,17 @@ impl<'a> Region<'a> {
 }
 
 fn raw_tensors<'a>(meta: &'a Metadata, data: Region<'a>) -> Result<HashMap<String, Raw<'a>>, BankError> {
+    raw_tensors_except(meta, data, None)
+}
+
+/// [`raw_tensors`] leaving out the tensor `skip` (whose bytes need not be in `data`).
+fn raw_tensors_except<'a>(
+    meta: &'a Metadata,
+    data: Region<'a>,
+    skip: Option<&str>,
+) -> Result<HashMap<String, Raw<'a>>, BankError> {
     let mut out = HashMap::new();
-    for (name, info) in meta.tensors() {
+    for (name, info) in meta.tensors().into_iter().filter(|(name, _)| Some(name.as_str()) != skip) {
         let (a, b) = info.data_offsets;
         let Some(bytes) = data.get(a, b) else {
             return Err(BankError::NotSafetensors(format!("tensor '{name}' lies outside the file")));
@@ -257,6 +266,13 @@ fn json<T: serde::de::DeserializeOwned>(meta: &HashMap<String, String>, key: &st
 /// Every field of the bank but `shapes` (left empty), whose dtype and shape
 /// are checked here; the caller fills it and validates.
 fn bank_without_shapes(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Result<ModeBank, BankError> {
+    let bank = bank_fields(t, meta)?;
+    t.get(T_SHAPES, Dtype::F32, &shapes_shape(bank.mode_count(), bank.surface_node_count()))?;
+    Ok(bank)
+}
+
+/// Every field of the bank but `shapes` (left empty and not looked at).
+fn bank_fields(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Result<ModeBank, BankError> {
     let material: Material = json(meta, KEY_MATERIAL)?;
     let info: SolveInfo = json(meta, KEY_SOLVE_INFO)?;
     let hash = meta.get(KEY_INPUT_HASH).ok_or_else(|| BankError::MissingMetadata(KEY_INPUT_HASH.into()))?;
@@ -268,13 +284,11 @@ fn bank_without_shapes(t: &Tensors<'_>, meta: &HashMap<String, String>) -> Resul
     }
     let n = t.len(T_FREQUENCIES, Dtype::F64, &[])?;
     let surface = surface(t)?;
-    let s = surface.positions.len();
     let per_mode = [Some(n)];
     let frequencies_hz = t.f64s(T_FREQUENCIES, &per_mode)?;
     let damping_ratios = t.f64s(T_DAMPING_RATIOS, &per_mode)?;
     let decay_rates = t.f64s(T_DECAY_RATES, &per_mode)?;
     let residuals = t.f64s(T_RESIDUALS, &per_mode)?;
-    t.get(T_SHAPES, Dtype::F32, &shapes_shape(n, s))?;
     Ok(ModeBank {
         frequencies_hz,
         damping_ratios,
@@ -313,6 +327,39 @@ pub(super) fn light_from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
     let meta = check_format(header.metadata().as_ref())?;
     let raw = raw_tensors(&header, Region::whole(data))?;
     bank_without_shapes(&Tensors(raw), meta)
+}
+
+/// [`light_from_bytes`] for a file, reading only the header and the tensors
+/// other than `shapes` (≈ 5 % of a TET10 bank's bytes). `None` for anything
+/// unusual (the caller then reads the whole file for the exact error).
+pub(super) fn light_from_file(file: &mut std::fs::File) -> Option<ModeBank> {
+    use std::io::{Read, Seek, SeekFrom};
+    let len = file.metadata().ok()?.len();
+    let mut prefix = [0u8; 8];
+    file.seek(SeekFrom::Start(0)).ok()?;
+    file.read_exact(&mut prefix).ok()?;
+    let n = u64::from_le_bytes(prefix);
+    if n > MAX_HEADER_BYTES || 8 + n > len {
+        return None;
+    }
+    let mut head = vec![0u8; n as usize];
+    file.read_exact(&mut head).ok()?;
+    let header: Metadata = serde_json::from_slice(&head).ok()?;
+    if 8 + n + header.data_len() as u64 != len {
+        return None;
+    }
+    let meta = check_format(header.metadata().as_ref()).ok()?;
+    let shapes = header.info(T_SHAPES).filter(|i| i.dtype == Dtype::F32)?;
+    let (a, b) = shapes.data_offsets;
+    let mut before = vec![0u8; a];
+    file.read_exact(&mut before).ok()?;
+    let mut after = vec![0u8; header.data_len().checked_sub(b)?];
+    file.seek(SeekFrom::Start(8 + n + b as u64)).ok()?;
+    file.read_exact(&mut after).ok()?;
+    let region = Region { pieces: [&before, &[], &after], split: (a, b) };
+    let t = Tensors(raw_tensors_except(&header, region, Some(T_SHAPES)).ok()?);
+    let bank = bank_fields(&t, meta).ok()?;
+    (shapes.shape == [bank.mode_count(), bank.surface_node_count(), 3]).then_some(bank)
 }
 
 /// Verifies the checksum on one thread while the other decodes the bank's

@@ -64,6 +64,12 @@ pub(crate) fn decode_light(bytes: &[u8]) -> Result<ModeBank, BankError> {
     decode::light_from_bytes(bytes)
 }
 
+/// [`decode_light`] reading only the header and the tensors but `shapes` of a
+/// file; `None` when the whole file must be read (see `decode::light_from_file`).
+pub(crate) fn decode_light_file(file: &mut std::fs::File) -> Option<ModeBank> {
+    decode::light_from_file(file)
+}
+
 impl ModeBank {
     /// Encodes the bank as a safetensors file in memory (validates first).
     pub fn to_bytes(&self) -> Result<Vec<u8>, BankError> {
