@@ -329,14 +329,13 @@ pub(super) fn light_from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
     bank_without_shapes(&Tensors(raw), meta)
 }
 
-/// [`light_from_bytes`] for a file, reading only the header and the tensors
-/// other than `shapes` (≈ 5 % of a TET10 bank's bytes). `None` for anything
-/// unusual (the caller then reads the whole file for the exact error).
-pub(super) fn light_from_file(file: &mut std::fs::File) -> Option<ModeBank> {
-    use std::io::{Read, Seek, SeekFrom};
+/// The safetensors header of a file read from its current position (the start),
+/// and the header's length `n`; `None` unless the tensor data announced ends
+/// exactly at the end of the file. The file is left at the start of the data.
+fn file_header(file: &mut std::fs::File) -> Option<(Metadata, u64)> {
+    use std::io::Read;
     let len = file.metadata().ok()?.len();
     let mut prefix = [0u8; 8];
-    file.seek(SeekFrom::Start(0)).ok()?;
     file.read_exact(&mut prefix).ok()?;
     let n = u64::from_le_bytes(prefix);
     if n > MAX_HEADER_BYTES || 8 + n > len {
@@ -345,9 +344,16 @@ pub(super) fn light_from_file(file: &mut std::fs::File) -> Option<ModeBank> {
     let mut head = vec![0u8; n as usize];
     file.read_exact(&mut head).ok()?;
     let header: Metadata = serde_json::from_slice(&head).ok()?;
-    if 8 + n + header.data_len() as u64 != len {
-        return None;
-    }
+    (8 + n + header.data_len() as u64 == len).then_some((header, n))
+}
+
+/// [`light_from_bytes`] for a file, reading only the header and the tensors
+/// other than `shapes` (≈ 5 % of a TET10 bank's bytes). `None` for anything
+/// unusual (the caller then reads the whole file for the exact error).
+pub(super) fn light_from_file(file: &mut std::fs::File) -> Option<ModeBank> {
+    use std::io::{Read, Seek, SeekFrom};
+    file.seek(SeekFrom::Start(0)).ok()?;
+    let (header, n) = file_header(file)?;
     let meta = check_format(header.metadata().as_ref()).ok()?;
     let shapes = header.info(T_SHAPES).filter(|i| i.dtype == Dtype::F32)?;
     let (a, b) = shapes.data_offsets;
@@ -389,19 +395,7 @@ const READ_PIECE: usize = 1 << 20;
 /// falls back to [`from_bytes`] for the exact error.
 pub(super) fn from_file(file: &mut std::fs::File) -> Option<ModeBank> {
     use std::io::Read;
-    let len = file.metadata().ok()?.len();
-    let mut prefix = [0u8; 8];
-    file.read_exact(&mut prefix).ok()?;
-    let n = u64::from_le_bytes(prefix);
-    if n > MAX_HEADER_BYTES || 8 + n > len {
-        return None;
-    }
-    let mut head = vec![0u8; n as usize];
-    file.read_exact(&mut head).ok()?;
-    let header: Metadata = serde_json::from_slice(&head).ok()?;
-    if 8 + n + header.data_len() as u64 != len {
-        return None;
-    }
+    let (header, _) = file_header(file)?;
     let meta = check_format(header.metadata().as_ref()).ok()?;
     let stored = meta.get(KEY_CHECKSUM)?;
     let shapes = header.info(T_SHAPES).filter(|i| i.dtype == Dtype::F32)?;
