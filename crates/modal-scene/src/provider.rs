@@ -154,6 +154,14 @@ impl ResolvedBanks {
                 Some(rest) => {
                     let bank = rest().map_err(|source| SceneError::Bank { path: path.clone(), source })?;
                     check_bank(&path, &bank)?;
+                    // The physics ran on the light bank: it must be the verified one.
+                    let light = &self.light[first];
+                    if light.surface != bank.surface
+                        || light.mass != bank.mass
+                        || light.material != bank.material
+                    {
+                        return Err(SceneError::invalid(&path, "the bank changed while it was being loaded"));
+                    }
                     Arc::new(bank)
                 }
             });

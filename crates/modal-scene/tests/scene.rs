@@ -162,3 +162,53 @@ fn demo_scene_parses_with_generated_meshes() {
         }
     }
 }
+
+/// Serves the slab provider's banks as pending ones (surface and mass first,
+/// the rest later), optionally completing the ball with another bank.
+struct PendingProvider {
+    inner: InMemoryProvider,
+    ball_completes_as: Option<modal_bank::ModeBank>,
+}
+
+impl modal_scene::BankProvider for PendingProvider {
+    fn bank(
+        &mut self,
+        request: &modal_scene::BankRequest,
+    ) -> Result<std::sync::Arc<modal_bank::ModeBank>, modal_scene::ProviderError> {
+        self.inner.bank(request)
+    }
+
+    fn provide(
+        &mut self,
+        request: &modal_scene::BankRequest,
+    ) -> Result<modal_scene::ProvidedBank, modal_scene::ProviderError> {
+        let full = (*self.inner.bank(request)?).clone();
+        let is_ball =
+            matches!(&request.mesh, Some(modal_scene::MeshSource::Generate(g)) if g.generate == "sphere");
+        let completed = match (&self.ball_completes_as, is_ball) {
+            (Some(other), true) => other.clone(),
+            _ => full.clone(),
+        };
+        let light = modal_bank::ModeBank { shapes: Vec::new(), ..full };
+        Ok(modal_scene::ProvidedBank::Pending {
+            light: Box::new(light),
+            rest: Box::new(move || Ok(completed)),
+        })
+    }
+}
+
+#[test]
+fn pending_banks_render_the_same_and_must_complete_as_announced() {
+    let scene = Scene::from_toml_str(BALL_ON_SLAB, Path::new(".")).expect("scene");
+    let ready = render(&scene, &mut slab_provider(), &RenderOptions::default()).expect("render");
+    let mut pending = PendingProvider { inner: slab_provider(), ball_completes_as: None };
+    let deferred = render(&scene, &mut pending, &RenderOptions::default()).expect("render");
+    assert_eq!(deferred.channels, ready.channels);
+    // A completion whose surface differs from the one the physics used is refused.
+    let other_ball = common::ball(0.025, &[1500.0, 3100.0]);
+    let mut changed = PendingProvider { inner: slab_provider(), ball_completes_as: Some(other_ball) };
+    match render(&scene, &mut changed, &RenderOptions::default()) {
+        Err(e) => assert!(e.to_string().contains("changed while it was being loaded"), "{e}"),
+        Ok(_) => panic!("a bank that changed while loading was accepted"),
+    }
+}
