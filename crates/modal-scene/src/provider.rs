@@ -131,31 +131,35 @@ impl BankProvider for InMemoryProvider {
 
 /// The banks of a scene's objects: complete or light (see [`ProvidedBank`]).
 pub(crate) struct ResolvedBanks {
-    /// One bank per object (identical assets share one `Arc`); light banks
-    /// have no shapes yet.
-    pub light: Vec<Arc<ModeBank>>,
-    /// Distinct assets asked for.
-    pub requested: usize,
-    /// Per object, its distinct asset.
+    /// Per distinct asset: its bank (light when pending), the work completing
+    /// it (`None`: already complete) and the first object's path for errors.
+    assets: Vec<(Arc<ModeBank>, Option<BankCompletion>, String)>,
+    /// Per object, its asset.
     asset_of: Vec<usize>,
-    /// Per distinct asset, the work completing it (`None`: already complete)
-    /// and the object path for errors.
-    completions: Vec<(Option<BankCompletion>, String)>,
 }
 
 impl ResolvedBanks {
-    /// The complete banks, one per object, sharing as the light ones do.
+    /// Distinct assets asked for.
+    pub fn requested(&self) -> usize {
+        self.assets.len()
+    }
+
+    /// One bank per object (instances of an asset share one `Arc`); pending
+    /// assets give their light bank, without shapes.
+    pub fn light(&self) -> Vec<Arc<ModeBank>> {
+        self.asset_of.iter().map(|&a| Arc::clone(&self.assets[a].0)).collect()
+    }
+
+    /// The complete banks, one per object, shared as the light ones are.
     pub fn complete(self) -> Result<Vec<Arc<ModeBank>>, SceneError> {
-        let mut full = Vec::with_capacity(self.completions.len());
-        for (asset, (rest, path)) in self.completions.into_iter().enumerate() {
-            let first = self.asset_of.iter().position(|&a| a == asset).unwrap_or(0);
+        let mut full = Vec::with_capacity(self.assets.len());
+        for (light, rest, path) in self.assets {
             full.push(match rest {
-                None => Arc::clone(&self.light[first]),
+                None => light,
                 Some(rest) => {
                     let bank = rest().map_err(|source| SceneError::Bank { path: path.clone(), source })?;
                     check_bank(&path, &bank)?;
                     // The physics ran on the light bank: it must be the verified one.
-                    let light = &self.light[first];
                     if light.surface != bank.surface
                         || light.mass != bank.mass
                         || light.material != bank.material
@@ -176,8 +180,7 @@ pub(crate) fn resolve_banks(
     provider: &mut dyn BankProvider,
 ) -> Result<ResolvedBanks, SceneError> {
     let mut requests: Vec<BankRequest> = Vec::new();
-    let mut distinct: Vec<Arc<ModeBank>> = Vec::new();
-    let mut completions = Vec::new();
+    let mut assets = Vec::new();
     let mut asset_of = Vec::with_capacity(scene.objects.len());
     for (i, object) in scene.objects.iter().enumerate() {
         let path = format!("objects[{i}]");
@@ -199,13 +202,11 @@ pub(crate) fn resolve_banks(
                 (Arc::from(light), Some(rest))
             }
         };
-        asset_of.push(distinct.len());
+        asset_of.push(assets.len());
         requests.push(request);
-        distinct.push(bank);
-        completions.push((rest, path));
+        assets.push((bank, rest, path));
     }
-    let light = asset_of.iter().map(|&a| Arc::clone(&distinct[a])).collect();
-    Ok(ResolvedBanks { light, requested: distinct.len(), asset_of, completions })
+    Ok(ResolvedBanks { assets, asset_of })
 }
 
 /// The scene relies on a bank's surface and mass properties; reject banks it

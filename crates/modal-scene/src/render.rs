@@ -171,9 +171,9 @@ pub fn render(
     };
     let t = Instant::now();
     let resolved = resolve_banks(scene, provider)?;
-    report.banks_requested = resolved.requested;
+    report.banks_requested = resolved.requested();
     report.banks_s = t.elapsed().as_secs_f64();
-    let light = resolved.light.clone();
+    let light = resolved.light();
     check_ground_clearance(original, &light[..original.objects.len()])?;
 
     let names: Vec<String> = (0..scene.objects.len()).map(|i| scene.object_name(i)).collect();
