@@ -7,7 +7,7 @@
 //! concurrent writers of one key are safe and readers never see partial files.
 //! A damaged entry is reported as [`BankError::CorruptCacheEntry`], never served.
 
-use crate::fsio::{atomic_write, read_bank};
+use crate::fsio::{atomic_write, decode_open_file, open_regular};
 use crate::DeferredBank;
 use crate::{BankError, ModeBank};
 use std::ffi::OsString;
@@ -52,19 +52,9 @@ impl BankCache {
     /// written for another key (warn, recompute, `put` over it).
     pub fn get(&self, key: &str) -> Result<Option<ModeBank>, BankError> {
         let path = self.path_for(key)?;
-        let loaded = match read_bank(&path) {
-            Ok(b) => b,
-            Err(BankError::Read { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
-                return Ok(None)
-            }
-            Err(e) => return Err(e),
-        };
-        let corrupt = |reason| BankError::CorruptCacheEntry { path: path.clone(), reason: Box::new(reason) };
-        let bank = loaded.map_err(corrupt)?;
-        if bank.info.input_hash != key {
-            return Err(corrupt(BankError::KeyMismatch { key: key.into(), found: bank.info.input_hash }));
-        }
-        Ok(Some(bank))
+        let Some(mut file) = open_entry(&path)? else { return Ok(None) };
+        let loaded = decode_open_file(&mut file, &path)?;
+        checked_entry(loaded, &path, key).map(Some)
     }
 
     /// [`Self::get`] in two steps (see [`DeferredBank`]): `Ok(None)` when there
@@ -73,14 +63,7 @@ impl BankCache {
     /// reports a damaged entry as [`BankError::CorruptCacheEntry`].
     pub fn get_deferred(&self, key: &str) -> Result<Option<(ModeBank, DeferredBank)>, BankError> {
         let path = self.path_for(key)?;
-        let file = match std::fs::File::open(&path) {
-            Ok(f) => f,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(source) => return Err(BankError::Read { path, source }),
-        };
-        if !file.metadata().is_ok_and(|m| m.is_file()) {
-            return Err(BankError::NotAFile { path });
-        }
+        let Some(file) = open_entry(&path)? else { return Ok(None) };
         DeferredBank::open(file, path, key).map(Some)
     }
 
@@ -132,4 +115,29 @@ pub fn default_dir_from(
         return Ok(xdg.join("modal"));
     }
     set(home).map(|h| h.join(".cache").join("modal")).ok_or(BankError::NoCacheDir)
+}
+
+/// The entry file at `path`, `None` when it does not exist.
+fn open_entry(path: &Path) -> Result<Option<std::fs::File>, BankError> {
+    match open_regular(path) {
+        Ok(file) => Ok(Some(file)),
+        Err(BankError::Read { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
+/// A cache entry's bank as decoded (`loaded`) if it is sound and was stored
+/// for `key`; otherwise [`BankError::CorruptCacheEntry`] with the reason.
+pub(crate) fn checked_entry(
+    loaded: Result<ModeBank, BankError>,
+    path: &Path,
+    key: &str,
+) -> Result<ModeBank, BankError> {
+    let corrupt =
+        |reason| BankError::CorruptCacheEntry { path: path.to_path_buf(), reason: Box::new(reason) };
+    let bank = loaded.map_err(corrupt)?;
+    if bank.info.input_hash != key {
+        return Err(corrupt(BankError::KeyMismatch { key: key.into(), found: bank.info.input_hash }));
+    }
+    Ok(bank)
 }

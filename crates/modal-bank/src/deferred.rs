@@ -11,10 +11,11 @@
 //! Step 2 ([`DeferredBank::finish`]) is [`ModeBank::load`] of the same file: the
 //! checksum, every check, the complete bank.
 
-use crate::format::{decode_file, decode_light, decode_light_file};
+use crate::cache::checked_entry;
+use crate::format::{decode_light, decode_light_file};
+use crate::fsio::{decode_open_file, read_whole};
 use crate::{BankError, ModeBank};
 use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
 use std::path::PathBuf;
 
 /// A cache entry read in part, its light bank decoded, its verification pending.
@@ -34,45 +35,20 @@ impl DeferredBank {
         path: PathBuf,
         key: &str,
     ) -> Result<(ModeBank, DeferredBank), BankError> {
-        let corrupt = |reason| BankError::CorruptCacheEntry { path: path.clone(), reason: Box::new(reason) };
         let light = match decode_light_file(&mut file) {
-            Some(light) => light,
+            Some(light) => Ok(light),
             // Anything unusual: read it all, so that the decoder names the problem.
-            None => {
-                let mut bytes = Vec::new();
-                let read_err = |source| BankError::Read { path: path.clone(), source };
-                file.seek(SeekFrom::Start(0)).map_err(read_err)?;
-                file.read_to_end(&mut bytes).map_err(read_err)?;
-                decode_light(&bytes).map_err(corrupt)?
-            }
+            None => decode_light(&read_whole(&mut file, &path)?),
         };
-        if light.info.input_hash != key {
-            return Err(corrupt(BankError::KeyMismatch { key: key.into(), found: light.info.input_hash }));
-        }
+        let light = checked_entry(light, &path, key)?;
         Ok((light, DeferredBank { file, path, key: key.into() }))
     }
 
     /// Step 2: the complete bank, checksum verified and validated — or the error
     /// [`ModeBank::from_bytes`] gives, as [`BankError::CorruptCacheEntry`]. The
-    /// file is decoded straight into the bank's buffers (as by [`ModeBank::load`]);
-    /// anything unusual takes `from_bytes` on the whole file for the exact error.
+    /// file is decoded as by [`ModeBank::load`], from the file opened in step 1.
     pub fn finish(mut self) -> Result<ModeBank, BankError> {
-        let path = self.path;
-        let corrupt = |reason| BankError::CorruptCacheEntry { path: path.clone(), reason: Box::new(reason) };
-        let read_err = |source| BankError::Read { path: path.clone(), source };
-        self.file.seek(SeekFrom::Start(0)).map_err(read_err)?;
-        let bank = match decode_file(&mut self.file) {
-            Some(bank) => bank,
-            None => {
-                let mut bytes = Vec::new();
-                self.file.seek(SeekFrom::Start(0)).map_err(read_err)?;
-                self.file.read_to_end(&mut bytes).map_err(read_err)?;
-                ModeBank::from_bytes(&bytes).map_err(corrupt)?
-            }
-        };
-        if bank.info.input_hash != self.key {
-            return Err(corrupt(BankError::KeyMismatch { key: self.key, found: bank.info.input_hash }));
-        }
-        Ok(bank)
+        let loaded = decode_open_file(&mut self.file, &self.path)?;
+        checked_entry(loaded, &self.path, &self.key)
     }
 }

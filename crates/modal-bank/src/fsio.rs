@@ -41,14 +41,14 @@ fn is_file(f: &std::fs::File) -> bool {
     f.metadata().is_ok_and(|m| m.is_file())
 }
 
-/// Reads a whole regular file.
-pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, BankError> {
+/// The whole content of the open file `file` (named `path` in I/O errors), from its start.
+pub(crate) fn read_whole(file: &mut std::fs::File, path: &Path) -> Result<Vec<u8>, BankError> {
+    use std::io::{Read, Seek, SeekFrom};
     let read_err = |source| BankError::Read { path: path.to_path_buf(), source };
-    let meta = std::fs::metadata(path).map_err(read_err)?;
-    if !meta.is_file() {
-        return Err(BankError::NotAFile { path: path.to_path_buf() });
-    }
-    std::fs::read(path).map_err(read_err)
+    let mut bytes = Vec::new();
+    file.seek(SeekFrom::Start(0)).map_err(read_err)?;
+    file.read_to_end(&mut bytes).map_err(read_err)?;
+    Ok(bytes)
 }
 
 impl ModeBank {
@@ -66,16 +66,35 @@ impl ModeBank {
     }
 }
 
+/// Opens the regular file at `path` (I/O errors and non-files name the path).
+pub(crate) fn open_regular(path: &Path) -> Result<std::fs::File, BankError> {
+    let file =
+        std::fs::File::open(path).map_err(|source| BankError::Read { path: path.to_path_buf(), source })?;
+    if !is_file(&file) {
+        return Err(BankError::NotAFile { path: path.to_path_buf() });
+    }
+    Ok(file)
+}
+
 /// Reads and decodes the bank file at `path`: the outer error is about
 /// reading the file (missing, not a file, I/O), the inner one about its
-/// content (format, checksum, validation). A regular file is read straight
-/// into the bank's buffers (`format::decode_file`); anything unusual takes
-/// [`read_file`] + [`ModeBank::from_bytes`], which give the exact error.
+/// content (format, checksum, validation).
 pub(crate) fn read_bank(path: &Path) -> Result<Result<ModeBank, BankError>, BankError> {
-    let fast =
-        std::fs::File::open(path).ok().filter(is_file).and_then(|mut f| crate::format::decode_file(&mut f));
-    match fast {
-        Some(bank) => Ok(Ok(bank)),
-        None => Ok(ModeBank::from_bytes(&read_file(path)?)),
+    decode_open_file(&mut open_regular(path)?, path)
+}
+
+/// Decodes the open bank file `file` (named `path` in I/O errors) from its
+/// start, straight into the bank's buffers (`format::decode_file`); anything
+/// unusual takes the whole file through [`ModeBank::from_bytes`], which gives
+/// the exact error. Outer error: I/O; inner: content.
+pub(crate) fn decode_open_file(
+    file: &mut std::fs::File,
+    path: &Path,
+) -> Result<Result<ModeBank, BankError>, BankError> {
+    use std::io::{Seek, SeekFrom};
+    file.seek(SeekFrom::Start(0)).map_err(|source| BankError::Read { path: path.to_path_buf(), source })?;
+    if let Some(bank) = crate::format::decode_file(file) {
+        return Ok(Ok(bank));
     }
+    Ok(ModeBank::from_bytes(&read_whole(file, path)?))
 }
