@@ -76,6 +76,7 @@ pub struct KsOutput {
 }
 
 /// Counters threaded through searches for progress reporting.
+#[derive(Default)]
 pub struct Counters {
     /// Restarts.
     pub restarts: usize,

@@ -42,8 +42,8 @@ const MAX_SEARCHES: usize = 4;
 /// `rigid_fields`: n × r raw rigid-body fields (any basis, need not be orthonormal) spanning
 /// the null space of K; they are M-orthonormalized and deflated. `None` if K is nonsingular.
 ///
-/// Runs on a rayon pool of [`EigenOptions::threads`] threads (block solves split by columns,
-/// sparse products split by rows); the result is bit-identical for any thread count.
+/// Runs on a rayon pool of [`EigenOptions::threads`] threads (sparse products split by rows,
+/// tall dense products by fixed row halves); the result is bit-identical for any thread count.
 /// `progress` is called on the calling thread.
 pub fn solve(
     k: &faer::sparse::SparseColMat<usize, f64>,
@@ -160,14 +160,7 @@ fn solve_validated(
     let below_known = if low_shift { elastic_below } else { 0 };
     let mut wanted = below_known + opts.max_modes;
     let cap = opts.max_modes;
-    let mut counters = Counters {
-        restarts: 0,
-        block_solves: 0,
-        residual_checks: 0,
-        block_solve_s: 0.0,
-        orthogonalize_s: 0.0,
-        residual_check_s: 0.0,
-    };
+    let mut counters = Counters::default();
     let mut searches = 0usize;
     let t_iter = Instant::now();
     let mut check_s = 0.0;

@@ -32,8 +32,9 @@ pub struct EigenOptions {
     pub block_size: usize,
     /// Fill-reducing ordering. Default [`Ordering::Auto`].
     pub ordering: Ordering,
-    /// Solver threads (0: one per core). Block solves run as two column groups and sparse
-    /// products by row ranges on these threads; the result does not depend on the count.
+    /// Solver threads (0: one per core). Sparse products run by row ranges and tall dense
+    /// products as two fixed row halves on these threads (block solves and factorizations
+    /// stay sequential); the result does not depend on the count.
     /// Default 0.
     pub threads: usize,
     /// Refuse to factor if the estimated memory exceeds this many bytes.
