@@ -82,12 +82,7 @@ position = [0.003, 0.12, 0.0]
 }
 
 fn bowl_provider() -> InMemoryProvider {
-    let glass = Material::preset("glass").expect("glass");
-    let bowl = modal_mesh::generate::bowl(0.06, 0.004, 0.008, 1).expect("bowl mesh");
-    let mut p = InMemoryProvider::new();
-    p.insert("bowl", common::bank_on(&bowl, glass, &[900.0, 2100.0]));
-    p.insert("sphere", common::ball(0.01, &[4000.0]));
-    p
+    common::bowl_and_ball(0.01)
 }
 
 /// Final centres of mass of the bowl and the ball [m].

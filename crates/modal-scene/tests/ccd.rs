@@ -15,13 +15,11 @@ mod common;
 
 use std::path::Path;
 
-use modal_fem::Material;
+use common::BOWL_RADIUS_M;
 use modal_scene::{render, InMemoryProvider, RenderOptions, Scene};
 
-/// Outer radius of the bowl's shell [m].
-const BOWL_RADIUS_M: f64 = 0.06;
 /// Height of the rim plane (the shell's sphere centre) above the bowl's
-/// centre of mass, for the bowl as generated below [m].
+/// centre of mass, for the bowl of `common::bowl_and_ball` [m].
 const RIM_ABOVE_COM_M: f64 = 0.029;
 /// Radius of the ball [m].
 const BALL_RADIUS_M: f64 = 0.005;
@@ -54,12 +52,7 @@ linear_velocity = [{speed_m_s}, 0.0, 0.0]
 }
 
 fn provider() -> InMemoryProvider {
-    let glass = Material::preset("glass").expect("glass");
-    let bowl = modal_mesh::generate::bowl(BOWL_RADIUS_M, 0.004, 0.008, 1).expect("bowl mesh");
-    let mut p = InMemoryProvider::new();
-    p.insert("bowl", common::bank_on(&bowl, glass, &[900.0, 2100.0]));
-    p.insert("sphere", common::ball(BALL_RADIUS_M, &[4000.0]));
-    p
+    common::bowl_and_ball(BALL_RADIUS_M)
 }
 
 #[test]
