@@ -6,8 +6,13 @@
 //! - `LLᵀ` (Cholesky) when σ is below the spectrum (A positive definite);
 //! - `LDLᵀ` (no pivoting) for an indefinite A. By Sylvester's law of inertia the number of
 //!   negative entries of D equals the number of eigenvalues of `K w = λ M w` below σ.
+//!
+//! A factor that serves block solves is repacked into row tiles ([`crate::tiled`]) and faer's
+//! copy of the values is freed: the Cholesky factor always (it exists only as the operator),
+//! an LDLᵀ factor when the driver makes it the operator ([`ShiftedFactor::prepare_solves`]).
 
 use crate::ordering::{metis_node_ordering, Permutation};
+use crate::tiled::{FactorKind, TiledFactor};
 use crate::types::{EigenError, OrderingUsed};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
@@ -104,10 +109,14 @@ pub struct ShiftedFactor<'a> {
     k: SparseColMatRef<'a, usize, f64>,
     m: SparseColMatRef<'a, usize, f64>,
     pattern: ShiftedPattern,
-    symbolic: SymbolicCholesky<usize>,
+    pub(crate) symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
     a_values: Vec<f64>,
     kind: Option<Kind>,
+    /// The current factor repacked for solves (then `values` is empty).
+    pub(crate) tiled: Option<TiledFactor>,
+    /// Length of the tiled values (0 for a simplicial factor).
+    tiled_len: usize,
     shift: f64,
     par: Par,
     /// Ordering that was used.
@@ -149,6 +158,7 @@ impl<'a> ShiftedFactor<'a> {
                 (s, OrderingUsed::Amd)
             }
         };
+        let tiled_len = TiledFactor::packed_len(&symbolic).unwrap_or(0);
         Ok(Self {
             k,
             m,
@@ -157,6 +167,8 @@ impl<'a> ShiftedFactor<'a> {
             values: Vec::new(),
             a_values: Vec::new(),
             kind: None,
+            tiled: None,
+            tiled_len,
             shift: f64::NAN,
             par,
             ordering,
@@ -168,12 +180,14 @@ impl<'a> ShiftedFactor<'a> {
         self.symbolic.len_val()
     }
 
-    /// Estimated peak bytes of one numeric factorization (factor values + scratch + A copy).
+    /// Estimated peak bytes of one numeric factor: the larger of the factorization (factor
+    /// values + scratch + A copy) and the repacking (factor values + tiled copy).
     pub fn memory_estimate(&self) -> u64 {
         let scratch =
             self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).size_bytes();
         let a = self.pattern.symbolic.row_idx().len() * 8 * 2;
-        (self.factor_nnz() * 8 + scratch + a) as u64
+        let values = self.factor_nnz() * 8;
+        (values + (scratch + a).max(self.tiled_len * 8)) as u64
     }
 
     /// Shift of the current factor.
@@ -182,6 +196,7 @@ impl<'a> ShiftedFactor<'a> {
     }
 
     fn fill(&mut self, sigma: f64) -> Result<(), EigenError> {
+        self.tiled = None;
         let mut a = std::mem::take(&mut self.a_values);
         self.pattern.values(self.k.val(), self.m.val(), sigma, &mut a);
         self.a_values = a;
@@ -223,6 +238,27 @@ impl<'a> ShiftedFactor<'a> {
         }
         self.kind = Some(Kind::Llt);
         self.shift = sigma;
+        self.prepare_solves()
+    }
+
+    /// Repacks the current factor for block solves and frees faer's copy of its values
+    /// (a simplicial factor of a small problem stays as it is and uses faer's solve).
+    pub fn prepare_solves(&mut self) -> Result<(), EigenError> {
+        let kind = match self.kind {
+            Some(Kind::Llt) => FactorKind::Llt,
+            Some(Kind::Ldlt) => FactorKind::Ldlt,
+            None => return Ok(()),
+        };
+        if self.tiled.is_some() {
+            return Ok(());
+        }
+        if TiledFactor::packed_len(&self.symbolic).is_none() {
+            return Ok(());
+        }
+        let tiled = TiledFactor::pack(&self.symbolic, &self.values, kind)
+            .ok_or_else(|| EigenError::Factorization("out of memory for the tiled factor".into()))?;
+        self.tiled = Some(tiled);
+        self.values = Vec::new();
         Ok(())
     }
 
@@ -277,11 +313,16 @@ impl<'a> ShiftedFactor<'a> {
 
     /// Solve workspace requirement for `ncols` right-hand sides.
     pub fn solve_scratch(&self, ncols: usize) -> StackReq {
-        self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par)
+        self.symbolic
+            .solve_in_place_scratch::<f64>(ncols, self.par)
+            .or(TiledFactor::scratch(self.symbolic.nrows()))
     }
 
     /// Solves `(K − σM) X = B` in place with the current factor.
     pub fn solve_in_place(&self, rhs: MatMut<'_, f64>, stack: &mut MemStack) {
+        if let Some(t) = &self.tiled {
+            return t.solve_in_place(rhs, stack);
+        }
         match self.kind {
             Some(Kind::Llt) => LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
                 faer::Conj::No,

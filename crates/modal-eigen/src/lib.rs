@@ -21,6 +21,7 @@ mod factor;
 mod krylov;
 mod ordering;
 mod solve;
+mod tiled;
 mod types;
 
 pub use krylov::attainable as residual_bound;

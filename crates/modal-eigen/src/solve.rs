@@ -150,6 +150,8 @@ fn solve_validated(
         let sigma = -lam_lo.max(SHIFT_FLOOR * lam_scale);
         stats.factorizations += 1;
         factor.factor_llt(sigma)?;
+    } else {
+        factor.prepare_solves()?;
     }
     stats.shift = factor.shift();
     stats.factor_s = t.elapsed().as_secs_f64();
@@ -294,7 +296,8 @@ fn refactor_operator(f: &mut ShiftedFactor<'_>, sigma: f64, low: bool) -> Result
     if low {
         f.factor_llt(sigma)
     } else {
-        f.factor_ldlt(sigma).map(|_| ())
+        f.factor_ldlt(sigma)?;
+        f.prepare_solves()
     }
 }
 
