@@ -20,6 +20,7 @@ mod block;
 mod factor;
 mod krylov;
 mod ordering;
+mod simd;
 mod solve;
 mod tiled;
 mod types;

@@ -24,6 +24,7 @@
 //! for AVX-512 and for AVX2 + FMA and chosen at run time, with a portable fallback. The
 //! arithmetic differs from faer's (summation order), not its accuracy (tests compare both).
 
+use crate::simd::{self, MulAdd};
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
@@ -209,30 +210,7 @@ impl TiledFactor {
     /// Both sweeps on permuted row-major right-hand sides (`n + 1` rows, the last zero).
     fn solve_rows(&self, x: &mut [Row]) {
         debug_assert_eq!(x.len(), self.n + 1);
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("fma") {
-                // SAFETY: the features were detected on this CPU.
-                return unsafe { self.solve_rows_avx512(x) };
-            }
-            if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-                // SAFETY: as above.
-                return unsafe { self.solve_rows_avx2(x) };
-            }
-        }
-        self.sweeps::<Separate>(x);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    unsafe fn solve_rows_avx512(&self, x: &mut [Row]) {
-        self.sweeps::<Avx512>(x);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn solve_rows_avx2(&self, x: &mut [Row]) {
-        self.sweeps::<Fused>(x);
+        simd::dispatch(Sweeps { factor: self, x });
     }
 
     #[inline(always)]
@@ -340,6 +318,20 @@ impl TiledFactor {
     }
 }
 
+/// [`TiledFactor::sweeps`] as a [`simd::Kernel`].
+struct Sweeps<'a> {
+    factor: &'a TiledFactor,
+    x: &'a mut [Row],
+}
+
+impl simd::Kernel for Sweeps<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<F: MulAdd>(self) {
+        self.factor.sweeps::<F>(self.x);
+    }
+}
+
 /// Tile offsets: (nodes, values length, padded rows length).
 fn layout(sn: &SymbolicSupernodalCholesky<usize>) -> (Vec<Node>, usize, usize) {
     let begin = sn.supernode_begin();
@@ -400,48 +392,6 @@ fn rows_minus_tile_t<F: MulAdd>(tile: &[f64], g: &[Row; TILE], ys: &mut [Row]) {
             }
         }
         *yj = v;
-    }
-}
-
-/// `a·b + c`, fused where the CPU has FMA.
-trait MulAdd {
-    /// Use the AVX-512 tile kernels (only inside `target_feature(enable = "avx512f")` code).
-    const AVX512: bool = false;
-    fn mul_add(a: f64, b: f64, c: f64) -> f64;
-}
-
-/// [`Fused`] plus the AVX-512 tile kernels.
-#[cfg(target_arch = "x86_64")]
-struct Avx512;
-
-#[cfg(target_arch = "x86_64")]
-impl MulAdd for Avx512 {
-    const AVX512: bool = true;
-    #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
-        a.mul_add(b, c)
-    }
-}
-
-/// Hardware fused multiply–add (only inside `target_feature(enable = "fma")` code).
-#[cfg(target_arch = "x86_64")]
-struct Fused;
-
-#[cfg(target_arch = "x86_64")]
-impl MulAdd for Fused {
-    #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
-        a.mul_add(b, c)
-    }
-}
-
-/// Separate multiply and add (portable fallback; a software fma would be slow).
-struct Separate;
-
-impl MulAdd for Separate {
-    #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
-        a * b + c
     }
 }
 
@@ -626,7 +576,7 @@ mod tests {
         let rows =
             |m: &Mat<f64>| -> Vec<Row> { (0..=n).map(|i| std::array::from_fn(|c| m[(i, c)])).collect() };
         let mut portable = rows(&start);
-        tiled.sweeps::<Separate>(&mut portable);
+        simd::run_portable(Sweeps { factor: &tiled, x: &mut portable });
         let scale = portable.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         let differs = |x: &[Row]| {
             x.iter().flatten().zip(portable.iter().flatten()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
@@ -635,11 +585,8 @@ mod tests {
         let mut dispatched = rows(&start);
         tiled.solve_rows(&mut dispatched);
         assert!(differs(&dispatched) < 1e-11, "dispatched: {:e}", differs(&dispatched));
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-            let mut avx2 = rows(&start);
-            // SAFETY: features detected.
-            unsafe { tiled.solve_rows_avx2(&mut avx2) };
+        let mut avx2 = rows(&start);
+        if simd::dispatch_avx2(Sweeps { factor: &tiled, x: &mut avx2 }).is_some() {
             assert!(differs(&avx2) < 1e-11, "avx2: {:e}", differs(&avx2));
         }
     }
