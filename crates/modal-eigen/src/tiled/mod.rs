@@ -24,12 +24,16 @@
 //! for AVX-512 and for AVX2 + FMA and chosen at run time, with a portable fallback. The
 //! arithmetic differs from faer's (summation order), not its accuracy (tests compare both).
 
+mod split;
+
 use crate::simd::{self, MulAdd};
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::MatMut;
+use split::Split;
+use std::ops::Range;
 
 /// Right-hand sides per sweep (one row = 8 × f64 = one cache line).
 pub const LANES: usize = 8;
@@ -72,6 +76,11 @@ impl Node {
     fn pattern_tile(&self, t: usize) -> usize {
         self.pattern + t * TILE * self.ncols
     }
+
+    /// Factor values stored (the work of one sweep through this supernode).
+    fn values(&self) -> usize {
+        self.pattern - self.diag + self.pattern_tiles * TILE * self.ncols
+    }
 }
 
 /// A supernodal `LLᵀ` or `LDLᵀ` factor in tiles, with its fill-reducing permutation.
@@ -87,6 +96,8 @@ pub struct TiledFactor {
     pivot_scale: Vec<f64>,
     /// `1/D_j` between the sweeps (LDLᵀ only).
     d_inv: Option<Vec<f64>>,
+    /// The two-core cut of the sweeps (`None`: one sequential pass).
+    split: Option<Split>,
 }
 
 /// Which kind of factor faer's values hold.
@@ -120,6 +131,7 @@ impl TiledFactor {
             rows: vec![n; total_rows],
             pivot_scale: vec![1.0; n],
             d_inv: (kind == FactorKind::Ldlt).then(|| vec![1.0; n]),
+            split: None,
         };
         out.values.try_reserve_exact(total).ok()?;
         out.values.resize(total, 0.0);
@@ -162,12 +174,31 @@ impl TiledFactor {
                 }
             }
         }
+        out.split = out.cut(sn, split::MIN_SPLIT_VALUES);
         Some(out)
+    }
+
+    /// The two-core cut of this factor's elimination tree (see [`split`]).
+    fn cut(&self, sn: &SymbolicSupernodalCholesky<usize>, min_values: usize) -> Option<Split> {
+        let mut node_of_column = vec![0usize; self.n];
+        for (s, node) in self.nodes.iter().enumerate() {
+            node_of_column[node.start..node.start + node.ncols].fill(s);
+        }
+        let ptr = sn.col_ptr_for_row_idx();
+        let rows = sn.row_idx();
+        // The parent of a supernode holds the first row of its pattern.
+        let parent: Vec<Option<usize>> = (0..self.nodes.len())
+            .map(|s| rows[ptr[s]..ptr[s + 1]].iter().min().map(|&r| node_of_column[r]))
+            .collect();
+        let work: Vec<usize> = self.nodes.iter().map(Node::values).collect();
+        let starts: Vec<usize> = self.nodes.iter().map(|n| n.start).collect();
+        let ncols: Vec<usize> = self.nodes.iter().map(|n| n.ncols).collect();
+        split::split(&starts, &ncols, &parent, &work, min_values)
     }
 
     /// Workspace of [`Self::solve_in_place`].
     pub fn scratch(n: usize) -> StackReq {
-        StackReq::new_aligned::<Row>(n + 1, 64)
+        StackReq::new_aligned::<Row>(n + 1, 64).and(StackReq::new_aligned::<Row>(n + 1, 64))
     }
 
     /// Solves `A X = B` in place for every column of `rhs` (n × p, any p), [`LANES`] columns
@@ -176,7 +207,8 @@ impl TiledFactor {
         let n = self.n;
         assert_eq!(rhs.nrows(), n, "tiled solve: wrong number of rows");
         // Row n stays zero: padded pattern rows point at it.
-        let (mut x, _) = stack.make_aligned_with::<Row>(n + 1, 64, |_| [0.0; LANES]);
+        let (mut x, stack) = stack.make_aligned_with::<Row>(n + 1, 64, |_| [0.0; LANES]);
+        let (mut private, _) = stack.make_aligned_with::<Row>(n + 1, 64, |_| [0.0; LANES]);
         let p = rhs.ncols();
         for c0 in (0..p).step_by(LANES) {
             let width = LANES.min(p - c0);
@@ -192,7 +224,7 @@ impl TiledFactor {
                     row[width..].fill(0.0);
                 }
             }
-            self.solve_rows(&mut x);
+            self.solve_rows(&mut x, &mut private);
             for c in 0..width {
                 let mut col = rhs.rb_mut().col_mut(c0 + c);
                 for (new, row) in x[..n].iter().enumerate() {
@@ -207,26 +239,58 @@ impl TiledFactor {
         self.perm.as_ref().map_or(new, |p| p[new])
     }
 
-    /// Both sweeps on permuted row-major right-hand sides (`n + 1` rows, the last zero).
-    fn solve_rows(&self, x: &mut [Row]) {
+    /// Both sweeps on permuted row-major right-hand sides `x` (`n + 1` rows, the last zero);
+    /// `private` (same size, row n zero) is bin 1's copy when the sweeps are split.
+    fn solve_rows(&self, x: &mut [Row], private: &mut [Row]) {
         debug_assert_eq!(x.len(), self.n + 1);
-        simd::dispatch(Sweeps { factor: self, x });
+        let Some(split) = &self.split else {
+            let all = 0..self.nodes.len();
+            self.run(std::slice::from_ref(&all), x, Sweep::Forward);
+            self.scale_by_d(x);
+            self.run(std::slice::from_ref(&all), x, Sweep::Backward);
+            return;
+        };
+        copy_rows(&split.bin1_rows, x, private);
+        for r in &split.top_rows {
+            private[r.clone()].fill([0.0; LANES]);
+        }
+        rayon::join(
+            || self.run(&split.bins[0], x, Sweep::Forward),
+            || self.run(&split.bins[1], private, Sweep::Forward),
+        );
+        copy_rows(&split.bin1_rows, private, x);
+        for r in &split.top_rows {
+            for (xr, pr) in x[r.clone()].iter_mut().zip(&private[r.clone()]) {
+                for (a, b) in xr.iter_mut().zip(pr) {
+                    *a += b;
+                }
+            }
+        }
+        self.run(&split.top, x, Sweep::Forward);
+        self.scale_by_d(x);
+        self.run(&split.top, x, Sweep::Backward);
+        copy_rows(&split.bin1_rows, x, private);
+        copy_rows(&split.top_rows, x, private);
+        rayon::join(
+            || self.run(&split.bins[0], x, Sweep::Backward),
+            || self.run(&split.bins[1], private, Sweep::Backward),
+        );
+        copy_rows(&split.bin1_rows, private, x);
     }
 
-    #[inline(always)]
-    fn sweeps<F: MulAdd>(&self, x: &mut [Row]) {
-        for node in &self.nodes {
-            self.forward_node::<F>(node, x);
-        }
+    /// One sweep over the supernodes of `ranges` (forward: in order; backward: reversed).
+    fn run(&self, ranges: &[Range<usize>], x: &mut [Row], sweep: Sweep) {
+        simd::dispatch(Sweeps { factor: self, ranges, x, sweep });
+    }
+
+    /// `x ← D⁻¹ x` between the sweeps of an LDLᵀ factor.
+    fn scale_by_d(&self, x: &mut [Row]) {
         if let Some(d_inv) = &self.d_inv {
             for (row, d) in x.iter_mut().zip(d_inv) {
                 for v in row.iter_mut() {
                     *v *= d;
                 }
             }
-        }
-        for node in self.nodes.iter().rev() {
-            self.backward_node::<F>(node, x);
         }
     }
 
@@ -318,17 +382,47 @@ impl TiledFactor {
     }
 }
 
-/// [`TiledFactor::sweeps`] as a [`simd::Kernel`].
+/// Direction of a sweep.
+#[derive(Copy, Clone, PartialEq, Eq)]
+enum Sweep {
+    /// `L y = b`.
+    Forward,
+    /// `Lᵀ x = y`.
+    Backward,
+}
+
+/// One sweep over some supernodes, as a [`simd::Kernel`].
 struct Sweeps<'a> {
     factor: &'a TiledFactor,
+    ranges: &'a [Range<usize>],
     x: &'a mut [Row],
+    sweep: Sweep,
 }
 
 impl simd::Kernel for Sweeps<'_> {
     type Output = ();
     #[inline(always)]
     fn run<F: MulAdd>(self) {
-        self.factor.sweeps::<F>(self.x);
+        let nodes = &self.factor.nodes;
+        match self.sweep {
+            Sweep::Forward => {
+                for node in self.ranges.iter().flat_map(|r| &nodes[r.clone()]) {
+                    self.factor.forward_node::<F>(node, self.x);
+                }
+            }
+            Sweep::Backward => {
+                for node in self.ranges.iter().rev().flat_map(|r| nodes[r.clone()].iter().rev()) {
+                    self.factor.backward_node::<F>(node, self.x);
+                }
+            }
+        }
+    }
+}
+
+/// `to[r] = from[r]` for the rows of `ranges`.
+fn copy_rows(ranges: &[Range<usize>], from: &[Row], to: &mut [Row]) {
+    for r in ranges {
+        to[r.clone()].copy_from_slice(&from[r.clone()]);
     }
 }
 
@@ -561,34 +655,65 @@ mod tests {
         }
     }
 
-    /// Two paths, one answer: the portable sweeps and every SIMD entry point this CPU has
-    /// agree to rounding.
+    /// Two paths, one answer: the portable sweeps, every SIMD entry point this CPU has, and
+    /// the two-core split of the sweeps agree to rounding; the split gives the same bits on
+    /// one thread as on two.
     #[test]
-    fn kernel_variants_agree() {
+    fn kernel_variants_and_split_agree() {
         let (a, _) = shifted_box(3, -1e-6);
         let sym = symbolic(&a);
         let values = numeric(&sym, &a, FactorKind::Llt);
-        let tiled = TiledFactor::pack(&sym, &values, FactorKind::Llt).unwrap();
+        let mut tiled = TiledFactor::pack(&sym, &values, FactorKind::Llt).unwrap();
+        let SymbolicCholeskyRaw::Supernodal(sn) = sym.raw() else { unreachable!() };
         let n = a.nrows();
         let mut rng = crate::block::Rng::new(3);
         let mut start = Mat::zeros(n + 1, LANES);
         rng.fill(start.as_mut().subrows_mut(0, n));
         let rows =
             |m: &Mat<f64>| -> Vec<Row> { (0..=n).map(|i| std::array::from_fn(|c| m[(i, c)])).collect() };
+        // Sequential sweeps through one kernel variant.
+        let all = 0..tiled.nodes.len();
+        let all = std::slice::from_ref(&all);
+        let sequential = |exec: &dyn Fn(Sweeps) -> Option<()>, x: &mut [Row]| -> Option<()> {
+            exec(Sweeps { factor: &tiled, ranges: all, x, sweep: Sweep::Forward })?;
+            exec(Sweeps { factor: &tiled, ranges: all, x, sweep: Sweep::Backward })
+        };
         let mut portable = rows(&start);
-        simd::run_portable(Sweeps { factor: &tiled, x: &mut portable });
+        sequential(
+            &|k| {
+                simd::run_portable(k);
+                Some(())
+            },
+            &mut portable,
+        );
         let scale = portable.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         let differs = |x: &[Row]| {
             x.iter().flatten().zip(portable.iter().flatten()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
                 / scale
         };
-        let mut dispatched = rows(&start);
-        tiled.solve_rows(&mut dispatched);
-        assert!(differs(&dispatched) < 1e-11, "dispatched: {:e}", differs(&dispatched));
         let mut avx2 = rows(&start);
-        if simd::dispatch_avx2(Sweeps { factor: &tiled, x: &mut avx2 }).is_some() {
+        if sequential(&|k| simd::dispatch_avx2(k), &mut avx2).is_some() {
             assert!(differs(&avx2) < 1e-11, "avx2: {:e}", differs(&avx2));
         }
+        assert!(tiled.split.is_none(), "a 1k-DOF factor is not split by default");
+        let mut private = vec![[0.0; LANES]; n + 1];
+        let mut dispatched = rows(&start);
+        tiled.solve_rows(&mut dispatched, &mut private);
+        assert!(differs(&dispatched) < 1e-11, "dispatched: {:e}", differs(&dispatched));
+        // Force the split and run it on two threads and on one.
+        tiled.split = tiled.cut(sn, 0);
+        let split = tiled.split.as_ref().expect("the tree of a box can be cut");
+        assert!(split.bins.iter().all(|b| !b.is_empty()) && !split.top.is_empty());
+        let solve_on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut x = rows(&start);
+            let mut private = vec![[0.0; LANES]; n + 1];
+            pool.install(|| tiled.solve_rows(&mut x, &mut private));
+            x
+        };
+        let two = solve_on(2);
+        assert!(differs(&two) < 1e-11, "split: {:e}", differs(&two));
+        assert!(two == solve_on(1), "the split must not depend on the thread count");
     }
 
     /// The same for an indefinite LDLᵀ (σ inside the spectrum).
@@ -618,6 +743,17 @@ mod tests {
         let sym = ShiftedFactor::analyze(asm.k.as_ref(), asm.m.as_ref(), true, Par::Seq).unwrap().symbolic;
         let values = numeric(&sym, &a, FactorKind::Llt);
         let tiled = TiledFactor::pack(&sym, &values, FactorKind::Llt).unwrap();
+        if let Some(sp) = &tiled.split {
+            let work = |rs: &[Range<usize>]| -> usize {
+                rs.iter().flat_map(|r| &tiled.nodes[r.clone()]).map(Node::values).sum()
+            };
+            eprintln!(
+                "two-core split: bins of {} and {} values, top {} values",
+                work(&sp.bins[0]),
+                work(&sp.bins[1]),
+                work(&sp.top)
+            );
+        }
         let reps: usize = std::env::var("TILED_REPS").ok().and_then(|s| s.parse().ok()).unwrap_or(20);
         let time = |f: &mut dyn FnMut()| {
             let t = std::time::Instant::now();
