@@ -180,14 +180,14 @@ impl<'a> ShiftedFactor<'a> {
         self.symbolic.len_val()
     }
 
-    /// Estimated peak bytes of one numeric factor: the larger of the factorization (factor
-    /// values + scratch + A copy) and the repacking (factor values + tiled copy).
+    /// Estimated peak bytes of one numeric factor: its values (or their tiles, repacked in
+    /// place, see [`TiledFactor::pack`]), the factorization scratch and the copy of A.
     pub fn memory_estimate(&self) -> u64 {
         let scratch =
             self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).size_bytes();
         let a = self.pattern.symbolic.row_idx().len() * 8 * 2;
-        let values = self.factor_nnz() * 8;
-        (values + (scratch + a).max(self.tiled_len * 8)) as u64
+        let values = self.factor_nnz().max(self.tiled_len) * 8;
+        (values + scratch + a) as u64
     }
 
     /// Shift of the current factor.
@@ -196,7 +196,10 @@ impl<'a> ShiftedFactor<'a> {
     }
 
     fn fill(&mut self, sigma: f64) -> Result<(), EigenError> {
-        self.tiled = None;
+        // A tiled factor's allocation serves the next factorization (no fresh pages).
+        if let Some(tiled) = self.tiled.take() {
+            self.values = tiled.into_values();
+        }
         let mut a = std::mem::take(&mut self.a_values);
         self.pattern.values(self.k.val(), self.m.val(), sigma, &mut a);
         self.a_values = a;
@@ -238,28 +241,25 @@ impl<'a> ShiftedFactor<'a> {
         }
         self.kind = Some(Kind::Llt);
         self.shift = sigma;
-        self.prepare_solves()
+        self.prepare_solves();
+        Ok(())
     }
 
-    /// Repacks the current factor for block solves and frees faer's copy of its values
-    /// (a simplicial factor of a small problem stays as it is and uses faer's solve).
-    pub fn prepare_solves(&mut self) -> Result<(), EigenError> {
+    /// Repacks the current factor into tiles for block solves, in place (a simplicial factor
+    /// of a small problem stays as it is and uses faer's solve).
+    pub fn prepare_solves(&mut self) {
         let kind = match self.kind {
             Some(Kind::Llt) => FactorKind::Llt,
             Some(Kind::Ldlt) => FactorKind::Ldlt,
-            None => return Ok(()),
+            None => return,
         };
         if self.tiled.is_some() {
-            return Ok(());
+            return;
         }
-        if TiledFactor::packed_len(&self.symbolic).is_none() {
-            return Ok(());
+        match TiledFactor::pack(&self.symbolic, std::mem::take(&mut self.values), kind) {
+            Ok(tiled) => self.tiled = Some(tiled),
+            Err(values) => self.values = values,
         }
-        let tiled = TiledFactor::pack(&self.symbolic, &self.values, kind)
-            .ok_or_else(|| EigenError::Factorization("out of memory for the tiled factor".into()))?;
-        self.tiled = Some(tiled);
-        self.values = Vec::new();
-        Ok(())
     }
 
     /// `K − σM = LDLᵀ` without pivoting; returns the number of negative pivots

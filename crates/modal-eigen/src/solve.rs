@@ -151,7 +151,7 @@ fn solve_validated(
         stats.factorizations += 1;
         factor.factor_llt(sigma)?;
     } else {
-        factor.prepare_solves()?;
+        factor.prepare_solves();
     }
     stats.shift = factor.shift();
     stats.factor_s = t.elapsed().as_secs_f64();
@@ -297,7 +297,8 @@ fn refactor_operator(f: &mut ShiftedFactor<'_>, sigma: f64, low: bool) -> Result
         f.factor_llt(sigma)
     } else {
         f.factor_ldlt(sigma)?;
-        f.prepare_solves()
+        f.prepare_solves();
+        Ok(())
     }
 }
 
