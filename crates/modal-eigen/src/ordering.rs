@@ -39,34 +39,56 @@ pub fn metis_node_ordering(pattern: SymbolicSparseColMatRef<'_, usize>) -> Optio
     Some(Permutation { fwd, inv })
 }
 
-/// Node adjacency (CSR, no self loops, deduplicated) in METIS' 32-bit format.
+/// Node adjacency (CSR, no self loops, deduplicated) in METIS' 32-bit format, from the
+/// upper (or full) DOF pattern. Each node's lower neighbours are found once with a stamp
+/// per node (no sorting) and entered in both directions; two passes (degrees, then lists)
+/// build the arrays in place.
 fn node_graph(pattern: SymbolicSparseColMatRef<'_, usize>, nodes: usize) -> Option<(Vec<i32>, Vec<i32>)> {
-    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-    for j in 0..pattern.ncols() {
-        let nj = j / 3;
-        for r in pattern.row_idx_of_col(j) {
-            let nr = r / 3;
-            if nr != nj {
-                lists[nj].push(nr as u32);
-                lists[nr].push(nj as u32);
+    // Calls `edge(a, b)` once per node pair a > b coupled by some entry.
+    let each_edge = |edge: &mut dyn FnMut(usize, usize)| {
+        let mut stamp = vec![usize::MAX; nodes];
+        for a in 0..nodes {
+            for j in 3 * a..3 * a + 3 {
+                for r in pattern.row_idx_of_col(j) {
+                    let b = r / 3;
+                    if b < a && stamp[b] != a {
+                        stamp[b] = a;
+                        edge(a, b);
+                    }
+                }
             }
         }
-    }
+    };
+    let mut degree = vec![0usize; nodes];
+    each_edge(&mut |a, b| {
+        degree[a] += 1;
+        degree[b] += 1;
+    });
     let mut xadj = Vec::with_capacity(nodes + 1);
-    let mut adjncy = Vec::new();
-    xadj.push(0i32);
-    for list in &mut lists {
-        list.sort_unstable();
-        list.dedup();
-        adjncy.extend(list.iter().map(|&v| v as i32));
-        if adjncy.len() > i32::MAX as usize {
-            return None;
-        }
-        xadj.push(adjncy.len() as i32);
-        *list = Vec::new();
+    xadj.push(0usize);
+    for d in &degree {
+        xadj.push(xadj.last().copied().unwrap_or(0) + d);
     }
-    Some((xadj, adjncy))
+    let total = *xadj.last()?;
+    if total > i32::MAX as usize {
+        return None;
+    }
+    let mut fill = xadj[..nodes].to_vec();
+    let mut adjncy = vec![0i32; total];
+    each_edge(&mut |a, b| {
+        adjncy[fill[a]] = b as i32;
+        fill[a] += 1;
+        adjncy[fill[b]] = a as i32;
+        fill[b] += 1;
+    });
+    Some((xadj.into_iter().map(|x| x as i32).collect(), adjncy))
 }
+
+/// METIS keeps its random number generator in process-wide statics (GKlib's `random.c`,
+/// reseeded at the start of every call): two calls at once race on it (undefined behaviour,
+/// and orderings — hence eigenvectors — that change with whatever else runs). Calls take
+/// turns; the lock is held for the 0.1 s an ordering takes.
+static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Calls `METIS_NodeND`; returns `perm` with `perm[new] = old`.
 fn metis_nd(nodes: usize, mut xadj: Vec<i32>, mut adjncy: Vec<i32>) -> Option<Vec<usize>> {
@@ -74,8 +96,11 @@ fn metis_nd(nodes: usize, mut xadj: Vec<i32>, mut adjncy: Vec<i32>) -> Option<Ve
     let mut options = vec![0i32; metis_sys::METIS_NOPTIONS as usize];
     let mut perm = vec![0i32; nodes];
     let mut iperm = vec![0i32; nodes];
+    // A poisoned lock only means another ordering panicked; METIS reseeds on entry.
+    let _turn = METIS_LOCK.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     // SAFETY: all arrays are sized as METIS documents (xadj: nvtxs+1, adjncy: xadj[nvtxs],
-    // options: METIS_NOPTIONS, perm/iperm: nvtxs) and live across the calls.
+    // options: METIS_NOPTIONS, perm/iperm: nvtxs) and live across the calls; METIS_LOCK
+    // serializes METIS' global state.
     let status = unsafe {
         metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
         options[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
