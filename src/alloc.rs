@@ -1,5 +1,6 @@
 //! The process's allocator: the system allocator, with large blocks aligned to
-//! 2 MiB and marked for transparent huge pages (`madvise(MADV_HUGEPAGE)`).
+//! 2 MiB and — for the commands that opt in with [`advise_huge_pages`] — marked
+//! for transparent huge pages (`madvise(MADV_HUGEPAGE)`).
 //!
 //! Why: a fresh block is faulted in page by page on first touch, and on the
 //! virtual machines measured a 4 KiB fault costs ≈ 4 µs — 8 MB of mode shapes
@@ -7,8 +8,23 @@
 //! demo. With huge pages the same block takes a handful of faults. Linux with
 //! THP in `madvise` mode (the common default) honours the hint; elsewhere it
 //! is ignored and only the alignment remains.
+//!
+//! Only the sound-making commands (`render`, `strike`), whose large blocks are
+//! banks read once, opt in. `precompute` does not: its hundreds of MB of fresh
+//! factor storage measured slower with huge pages here (30k-DOF precompute,
+//! 11 alternating pairs: faster without in 10, by 0.1–0.55 s of 2.3–3.6 s, with
+//! more kernel time clearing 2 MiB pages).
 
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Whether large blocks are advised for huge pages (see the module docs).
+static ADVISE: AtomicBool = AtomicBool::new(false);
+
+/// Marks every large block allocated from now on for transparent huge pages.
+pub fn advise_huge_pages() {
+    ADVISE.store(true, Ordering::Relaxed);
+}
 
 /// Blocks at least this large are huge-page aligned and advised.
 const HUGE_BLOCK_BYTES: usize = 4 << 20;
@@ -31,7 +47,7 @@ impl HugePageAlloc {
 
     fn advise(ptr: *mut u8, layout: Layout) {
         #[cfg(target_os = "linux")]
-        if !ptr.is_null() && layout.size() >= HUGE_BLOCK_BYTES {
+        if !ptr.is_null() && layout.size() >= HUGE_BLOCK_BYTES && ADVISE.load(Ordering::Relaxed) {
             // SAFETY: `ptr..ptr + size` is a block we just allocated; madvise
             // only changes how the kernel backs it (an error is harmless).
             unsafe {
@@ -110,6 +126,7 @@ mod tests {
 
     #[test]
     fn large_blocks_are_aligned_zeroed_and_keep_their_bytes_across_reallocs() {
+        advise_huge_pages();
         let a = HugePageAlloc;
         let big = Layout::from_size_align(HUGE_BLOCK_BYTES + 123, 8).unwrap();
         // SAFETY: every pointer comes from `a` with the layout it is freed with.

@@ -37,6 +37,9 @@ pub fn run() -> ExitCode {
 }
 
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
+    if matches!(cli.command, None | Some(Command::Render(_)) | Some(Command::Strike(_))) {
+        crate::alloc::advise_huge_pages();
+    }
     match cli.command {
         None => render::run(args::RenderArgs::default()),
         Some(Command::Precompute(args)) => precompute::run(args),
