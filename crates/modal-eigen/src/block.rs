@@ -201,9 +201,13 @@ impl Deflation {
 
     /// Appends M-orthonormal vectors `w` (already M-orthogonal to the set).
     pub fn extend(&mut self, m: SparseColMatRef<'_, usize, f64>, w: MatRef<'_, f64>) {
+        *self = self.extended(m, w);
+    }
+
+    /// This set plus M-orthonormal vectors `w` (already M-orthogonal to it).
+    pub fn extended(&self, m: SparseColMatRef<'_, usize, f64>, w: MatRef<'_, f64>) -> Deflation {
         let mw = spmm(m, w);
-        self.v = hcat(self.v.as_ref(), w);
-        self.mv = hcat(self.mv.as_ref(), mw.as_ref());
+        Deflation { v: hcat(self.v.as_ref(), w), mv: hcat(self.mv.as_ref(), mw.as_ref()) }
     }
 
     /// z ← z − V (MV)ᵀ z.

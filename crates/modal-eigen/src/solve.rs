@@ -93,7 +93,7 @@ fn solve_validated(
     let lam_scale = spectrum_scale(k, m)?;
     stats.lambda_scale = lam_scale;
 
-    // Rigid-body deflation.
+    // Rigid-body deflation (searches after the first also deflate the pairs found).
     let mut defl = Deflation::empty(n);
     if let Some(r) = rigid_fields {
         if r.ncols() > 0 {
@@ -169,6 +169,16 @@ fn solve_validated(
     progress(Progress::PhaseStart(Phase::Iterate));
     loop {
         searches += 1;
+        // Built only for a repeated search: after a single one (the rule) the pairs found
+        // never need their M-images (a sparse product on all of them).
+        let with_known;
+        let defl = match &known.vectors {
+            Some(v) => {
+                with_known = defl.extended(m, v.as_ref());
+                &with_known
+            }
+            None => &defl,
+        };
         let free = n - defl.len();
         let nev = wanted.min(free);
         let ncv = basis_size(nev, block).min(free.saturating_sub(block));
@@ -180,7 +190,7 @@ fn solve_validated(
             in_band >= cap || l.iter().any(|&x| x > lam_hi) || all.len() >= free
         };
         let (out, early) = if ncv < nev + block || free <= 2 * block + nev {
-            (dense_all(k, m, &defl)?, None)
+            (dense_all(k, m, defl)?, None)
         } else {
             let cfg = KsConfig {
                 nev,
@@ -202,14 +212,14 @@ fn solve_validated(
                         handle = Some((sig, scope.spawn(move || f.inertia_at(sig))));
                     }
                 };
-                let out = search(f, k, m, &defl, &cfg, &enough, &mut early, &mut counters, progress);
+                let out = search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, progress);
                 let early =
                     handle.and_then(|(sig, h)| h.join().ok().and_then(Result::ok).map(|nu| (sig, nu)));
                 (out, early)
             });
             (out?, early)
         };
-        known.merge(out.lambdas, out.vectors, out.residuals, m, &mut defl);
+        known.merge(out.lambdas, out.vectors, out.residuals);
 
         // Select, polish, check.
         let t_check = Instant::now();
@@ -358,15 +368,8 @@ struct Known {
 }
 
 impl Known {
-    /// Adds new pairs, sorts, and deflates them for later searches.
-    fn merge(
-        &mut self,
-        l: Vec<f64>,
-        v: Mat<f64>,
-        r: Vec<f64>,
-        m: SparseColMatRef<'_, usize, f64>,
-        defl: &mut Deflation,
-    ) {
+    /// Adds new pairs (M-orthogonal to all known ones: they were deflated) and sorts.
+    fn merge(&mut self, l: Vec<f64>, v: Mat<f64>, r: Vec<f64>) {
         debug_assert_eq!(l.len(), r.len());
         // New pairs are M-orthogonal to everything deflated (old pairs and rigid modes).
         let mut lam = std::mem::take(&mut self.lambdas);
@@ -386,7 +389,6 @@ impl Known {
         self.lambdas = order.iter().map(|&o| lam[o]).collect();
         self.residuals = order.iter().map(|&o| res[o]).collect();
         self.vectors = Some(sorted);
-        defl.extend(m, v.as_ref());
     }
 
     /// The pairs `sel` as they are. Valid as final answer when they all come from one search:
