@@ -8,13 +8,16 @@
 //!
 //! Method: METIS nested-dissection ordering of the node graph, one symbolic Cholesky analysis
 //! reused for every shift, shift-invert around a shift scaled to the problem, restarted block
-//! Krylov–Schur in the M-inner product with explicit rigid-mode deflation
-//! (see [`solve`] and the module docs of `krylov`, `factor`, `ordering`).
+//! Krylov–Schur in the M-inner product with explicit rigid-mode deflation; its block solves
+//! run on the Cholesky factor repacked into row tiles, split over two cores along the
+//! elimination tree (see [`solve`] and the module docs of `krylov`, `factor`, `tiled`,
+//! `ordering`).
 //!
 //! Reproducibility: for a given build and CPU the result is bit-identical whatever the
-//! thread count (parallel work is split at fixed points). Any change here that alters results,
-//! even in the last bit, must bump `modal_precompute::SOLVER_VERSION` (cached banks would
-//! otherwise differ from fresh solves, and scenes promise the same WAV either way).
+//! thread count (parallel work is split at fixed points) and whatever else runs in the
+//! process (METIS calls, which share global state, take turns). Any change here that alters
+//! results, even in the last bit, must bump `modal_precompute::SOLVER_VERSION` (cached banks
+//! would otherwise differ from fresh solves, and scenes promise the same WAV either way).
 
 mod block;
 mod factor;
