@@ -69,8 +69,15 @@ fn main() {
     let s = &sol.stats;
     let f = sol.frequencies_hz();
     let worst = sol.residuals.iter().cloned().fold(0.0, f64::max);
+    // FNV-1a over the bits of every eigenvalue and vector entry: equal across runs
+    // (e.g. THREADS=1 vs 2) iff the results are bit-identical.
+    let mut bits = 0xcbf2_9ce4_8422_2325u64;
+    let vectors = (0..sol.vectors.ncols()).flat_map(|j| (0..sol.vectors.nrows()).map(move |i| (i, j)));
+    for v in sol.eigenvalues.iter().copied().chain(vectors.map(|(i, j)| sol.vectors[(i, j)])) {
+        bits = (bits ^ v.to_bits()).wrapping_mul(0x100_0000_01b3);
+    }
     println!(
-        "{kind} h={h} dofs={} modes={} assemble={t_asm:.3}s symbolic={:.3}s factor={:.3}s iterate={:.3}s (block_solves {:.3}s orth {:.3}s checks {:.3}s) check={:.3}s total_solve={total:.3}s nnzL={} ordering={:?} restarts={} block_solves={} residual_checks={} factorizations={} inertia={}/{} max_res={worst:.2e} f1={:.2} f_last={:.2}",
+        "{kind} h={h} dofs={} modes={} assemble={t_asm:.3}s symbolic={:.3}s factor={:.3}s iterate={:.3}s (block_solves {:.3}s orth {:.3}s checks {:.3}s) check={:.3}s total_solve={total:.3}s nnzL={} ordering={:?} restarts={} block_solves={} residual_checks={} factorizations={} inertia={}/{} max_res={worst:.2e} f1={:.2} f_last={:.2} bits={bits:016x}",
         k.nrows(), f.len(), s.symbolic_s, s.factor_s, s.solve_s, s.block_solve_s, s.orthogonalize_s, s.residual_check_s, s.check_s, s.factor_nnz, s.ordering.unwrap(), s.iterations, s.block_solves, s.residual_checks, s.factorizations,
         s.inertia_expected, s.inertia_found, f.first().unwrap_or(&0.0), f.last().unwrap_or(&0.0)
     );
