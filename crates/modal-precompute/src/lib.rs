@@ -29,8 +29,9 @@ pub use pipeline::{
 /// a bank came from the cache or from a fresh solve, and the basis chosen
 /// within a repeated eigenvalue follows every rounding.
 /// History: 2 — session 3's parallel sparse/dense products in modal-eigen; 3 — the
-/// block solves run on the factor repacked into row tiles (`modal-eigen` `tiled`).
-pub const SOLVER_VERSION: &str = "modal-precompute-3";
+/// block solves run on the factor repacked into row tiles (`modal-eigen` `tiled`); 4 — the
+/// Cholesky factorization of large factors runs in parallel (two tasks).
+pub const SOLVER_VERSION: &str = "modal-precompute-4";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]
