@@ -23,6 +23,8 @@
 //! Each 8 × 8 tile step is 64 fused multiply–adds on 8 factor values: the kernel is compiled
 //! for AVX-512 and for AVX2 + FMA and chosen at run time, with a portable fallback. The
 //! arithmetic differs from faer's (summation order), not its accuracy (tests compare both).
+//! The tiles are written into faer's own allocation ([`TiledFactor::pack`]), and the sweeps
+//! are split over two cores along the elimination tree (`split`).
 
 mod split;
 
@@ -48,9 +50,9 @@ struct Node {
     start: usize,
     /// Number of columns.
     ncols: usize,
-    /// Offset of its first diagonal tile in `values`.
+    /// Offset of its first diagonal tile in the tiles.
     diag: usize,
-    /// Offset of its first pattern tile in `values`.
+    /// Offset of its first pattern tile in the tiles.
     pattern: usize,
     /// Offset of its padded pattern rows in `rows`.
     rows: usize,
