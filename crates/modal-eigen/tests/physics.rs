@@ -160,7 +160,7 @@ fn thread_count_does_not_change_a_single_bit() {
 #[test]
 fn concurrent_solves_give_the_same_bits() {
     // METIS keeps its random generator in process-wide statics: before its calls were
-    // serialized, two solves running at once in one process (tests, a scene's banks) got
+    // serialized, two solves running at once in one process (as in this test binary) got
     // different orderings and eigenvectors differing in the last bits (7 of 40 runs).
     let mesh = bar_mesh(0.3, 0.02, 0.01, [40, 3, 2]);
     let opts = EigenOptions { max_modes: 12, max_freq_hz: 1e6, threads: 1, ..Default::default() };
