@@ -77,8 +77,9 @@ fn main() {
         bits = (bits ^ v.to_bits()).wrapping_mul(0x100_0000_01b3);
     }
     println!(
-        "{kind} h={h} dofs={} modes={} assemble={t_asm:.3}s symbolic={:.3}s factor={:.3}s iterate={:.3}s (block_solves {:.3}s orth {:.3}s checks {:.3}s) check={:.3}s total_solve={total:.3}s nnzL={} ordering={:?} restarts={} block_solves={} residual_checks={} factorizations={} inertia={}/{} max_res={worst:.2e} f1={:.2} f_last={:.2} bits={bits:016x}",
+        "{kind} h={h} dofs={} modes={} assemble={t_asm:.3}s symbolic={:.3}s factor={:.3}s iterate={:.3}s (block_solves {:.3}s orth {:.3}s checks {:.3}s) check={:.3}s total_solve={total:.3}s nnzL={} ordering={:?} restarts={} block_solves={} residual_checks={} factorizations={} inertia={}/{} max_res={worst:.2e} f1={:.2} f_last={:.2} bits={bits:016x} mem_estimate={}MB",
         k.nrows(), f.len(), s.symbolic_s, s.factor_s, s.solve_s, s.block_solve_s, s.orthogonalize_s, s.residual_check_s, s.check_s, s.factor_nnz, s.ordering.unwrap(), s.iterations, s.block_solves, s.residual_checks, s.factorizations,
-        s.inertia_expected, s.inertia_found, f.first().unwrap_or(&0.0), f.last().unwrap_or(&0.0)
+        s.inertia_expected, s.inertia_found, f.first().unwrap_or(&0.0), f.last().unwrap_or(&0.0),
+        s.memory_estimate_bytes >> 20
     );
 }

@@ -177,3 +177,26 @@ fn concurrent_solves_give_the_same_bits() {
         }
     });
 }
+
+#[test]
+fn memory_guard_refuses_before_factoring_with_a_clear_error() {
+    // The guard runs after the symbolic analysis, before any numeric factorization.
+    let mesh = bar_mesh(0.3, 0.02, 0.01, [40, 3, 2]);
+    let a = assemble(&mesh, &steel(E)).unwrap();
+    let (part, n_parts) = node_parts(&mesh);
+    let rigid = rigid_body_fields(&mesh.nodes, &part, n_parts, &[]);
+    let opts = EigenOptions { memory_limit_bytes: Some(1_000_000), ..Default::default() };
+    let err = solve(&a.k, &a.m, Some(rigid.as_ref()), &opts, &mut |_| {}).unwrap_err();
+    match &err {
+        modal_eigen::EigenError::MemoryLimit { estimated, limit } => {
+            assert_eq!(*limit, 1_000_000);
+            assert!(*estimated > *limit, "{estimated}");
+        }
+        other => panic!("expected the memory guard, got {other:?}"),
+    }
+    let message = err.to_string();
+    assert!(message.contains("--order 1") && message.contains("coarser mesh"), "{message}");
+    // With room to spare the same problem solves.
+    let roomy = EigenOptions { memory_limit_bytes: Some(1 << 34), max_modes: 4, ..Default::default() };
+    assert!(solve(&a.k, &a.m, Some(rigid.as_ref()), &roomy, &mut |_| {}).is_ok());
+}
