@@ -250,6 +250,13 @@ impl<'a> ShiftedFactor<'a> {
         (values + scratch + a) as u64
     }
 
+    /// Bytes of the shifted pattern and its maps from K and M (held for the whole solve).
+    pub fn pattern_bytes(&self) -> u64 {
+        let entries = self.pattern.symbolic.row_idx().len() + self.pattern.symbolic.col_ptr().len();
+        let maps = (self.pattern.k_map.len() + self.pattern.m_map.len()) * 16;
+        (entries * 8 + maps) as u64
+    }
+
     /// Shift of the current factor.
     pub fn shift(&self) -> f64 {
         self.shift

@@ -118,7 +118,8 @@ fn solve_validated(
     let block = opts.block_size.min(n.saturating_sub(n_rigid).max(1));
     let nev_guess = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
     let ncv_guess = basis_size(nev_guess, block);
-    stats.memory_estimate_bytes = factor.memory_estimate() + (n * (ncv_guess + 4 * block) * 8) as u64;
+    stats.memory_estimate_bytes =
+        factor.memory_estimate() + factor.pattern_bytes() + vector_bytes(n, nev_guess, ncv_guess, block);
     let limit = opts.memory_limit_bytes.or_else(default_memory_limit);
     if let Some(limit) = limit {
         if stats.memory_estimate_bytes > limit {
@@ -299,6 +300,13 @@ fn solve_validated(
 /// capped so that orthogonalization and memory stay linear in nev.
 fn basis_size(nev: usize, block: usize) -> usize {
     nev + nev.max((2 * nev).min(EXTRA_BASIS)).max(3 * block)
+}
+
+/// Dense n-vectors the iteration holds at its peak: the basis V and its M-image (ncv + one
+/// block each), a few blocks of work space, and the residual check's Ritz vectors with their
+/// K- and M-images and rotated copies (six sets of up to `nev` vectors).
+fn vector_bytes(n: usize, nev: usize, ncv: usize, block: usize) -> u64 {
+    (n * (2 * (ncv + block) + 4 * block + 6 * nev) * 8) as u64
 }
 
 /// Re-establishes the operator factor after an inertia factorization replaced it.
