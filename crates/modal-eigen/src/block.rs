@@ -429,35 +429,21 @@ pub fn residuals_from(lambdas: &[f64], kw: MatRef<'_, f64>, mw: MatRef<'_, f64>)
 #[cfg(test)]
 mod speed {
     use super::*;
+    use crate::test_support::{steel_box, time_ms};
 
     /// `cargo test --release -p modal-eigen --lib spmm_speed -- --ignored --nocapture`
     #[test]
     #[ignore]
     fn spmm_speed() {
-        let mesh = modal_mesh::to_quadratic(&modal_mesh::generate::box_mesh([0.2, 0.15, 0.1], [14, 11, 7]));
-        let mat = modal_fem::Material::custom(200e9, 0.3, 7850.0, 0.0, 0.0).unwrap();
-        let asm = modal_fem::assemble(&mesh, &mat).unwrap();
+        let asm = steel_box([14, 11, 7]);
         let n = asm.k.nrows();
         for p in [8, 58] {
             let mut x = Mat::zeros(n, p);
             Rng::new(1).fill(x.as_mut());
-            let reps = 20;
-            let t = std::time::Instant::now();
-            for _ in 0..reps {
-                std::hint::black_box(spmm(asm.k.as_ref(), x.as_ref()));
-            }
-            let dt = t.elapsed().as_secs_f64() / reps as f64;
-            let t = std::time::Instant::now();
-            for _ in 0..reps {
-                std::hint::black_box(tmul(x.as_ref(), x.as_ref()));
-            }
-            let dt2 = t.elapsed().as_secs_f64() / reps as f64;
-            eprintln!(
-                "n {n} nnz {} p {p}: spmm {:.2} ms, tmul xtx {:.2} ms",
-                asm.k.compute_nnz(),
-                dt * 1e3,
-                dt2 * 1e3
-            );
+            let spmm_ms = time_ms(20, &mut || drop(std::hint::black_box(spmm(asm.k.as_ref(), x.as_ref()))));
+            let tmul_ms = time_ms(20, &mut || drop(std::hint::black_box(tmul(x.as_ref(), x.as_ref()))));
+            let nnz = asm.k.compute_nnz();
+            eprintln!("n {n} nnz {nnz} p {p}: spmm {spmm_ms:.2} ms, tmul xtx {tmul_ms:.2} ms");
         }
     }
 }

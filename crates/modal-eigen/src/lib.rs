@@ -25,6 +25,8 @@ mod krylov;
 mod ordering;
 mod simd;
 mod solve;
+#[cfg(test)]
+mod test_support;
 mod tiled;
 mod types;
 

@@ -18,11 +18,17 @@ fn steel(e: f64) -> Material {
     Material::custom(e, NU, RHO, 0.0, 0.0).unwrap()
 }
 
-/// Free solve with one rigid set per connected part; asserts all invariants.
-fn solve_free(mesh: &TetMesh, mat: &Material, opts: &EigenOptions) -> EigenSolution {
+/// K, M and one rigid set per connected part of a free mesh.
+fn free_problem(mesh: &TetMesh, mat: &Material) -> (modal_fem::Assembly, faer::Mat<f64>, usize) {
     let a = assemble(mesh, mat).unwrap();
     let (part, n_parts) = node_parts(mesh);
     let rigid = rigid_body_fields(&mesh.nodes, &part, n_parts, &[]);
+    (a, rigid, n_parts)
+}
+
+/// Free solve with one rigid set per connected part; asserts all invariants.
+fn solve_free(mesh: &TetMesh, mat: &Material, opts: &EigenOptions) -> EigenSolution {
+    let (a, rigid, n_parts) = free_problem(mesh, mat);
     let sol = solve(&a.k, &a.m, Some(rigid.as_ref()), opts, &mut |_| {}).unwrap();
     check_solution(&a.k, &a.m, &sol, opts);
     assert_eq!(sol.stats.rigid_modes_removed, 6 * n_parts);
@@ -181,10 +187,7 @@ fn concurrent_solves_give_the_same_bits() {
 #[test]
 fn memory_guard_refuses_before_factoring_with_a_clear_error() {
     // The guard runs after the symbolic analysis, before any numeric factorization.
-    let mesh = bar_mesh(0.3, 0.02, 0.01, [40, 3, 2]);
-    let a = assemble(&mesh, &steel(E)).unwrap();
-    let (part, n_parts) = node_parts(&mesh);
-    let rigid = rigid_body_fields(&mesh.nodes, &part, n_parts, &[]);
+    let (a, rigid, _) = free_problem(&bar_mesh(0.3, 0.02, 0.01, [40, 3, 2]), &steel(E));
     let opts = EigenOptions { memory_limit_bytes: Some(1_000_000), ..Default::default() };
     let err = solve(&a.k, &a.m, Some(rigid.as_ref()), &opts, &mut |_| {}).unwrap_err();
     match &err {

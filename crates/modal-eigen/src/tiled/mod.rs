@@ -590,6 +590,7 @@ mod avx512 {
 mod tests {
     use super::*;
     use crate::factor::ShiftedFactor;
+    use crate::test_support::{steel_box, time_ms};
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
     use faer::linalg::cholesky::llt::factor::LltRegularization;
@@ -601,9 +602,7 @@ mod tests {
 
     /// K − σM of a TET10 steel box with `cells` per side (upper triangle is what faer reads).
     fn shifted_box(cells: usize, sigma_rel: f64) -> (SparseColMat<usize, f64>, f64) {
-        let mesh = modal_mesh::to_quadratic(&modal_mesh::generate::box_mesh([0.2, 0.15, 0.1], [cells; 3]));
-        let mat = modal_fem::Material::custom(200e9, 0.3, 7850.0, 0.0, 0.0).unwrap();
-        let a = modal_fem::assemble(&mesh, &mat).unwrap();
+        let a = steel_box([cells; 3]);
         // σ relative to the spectrum scale max Kᵢᵢ/Mᵢᵢ.
         let scale = (0..a.k.ncols())
             .map(|j| a.k.get(j, j).copied().unwrap_or(0.0) / a.m.get(j, j).copied().unwrap())
@@ -799,9 +798,7 @@ mod tests {
     #[test]
     #[ignore]
     fn tiled_solve_speed() {
-        let mesh = modal_mesh::to_quadratic(&modal_mesh::generate::box_mesh([0.2, 0.15, 0.1], [14, 11, 7]));
-        let mat = modal_fem::Material::custom(200e9, 0.3, 7850.0, 0.0, 0.0).unwrap();
-        let asm = modal_fem::assemble(&mesh, &mat).unwrap();
+        let asm = steel_box([14, 11, 7]);
         let a = &asm.k + &(&asm.m * faer::Scale(1e-3));
         let sym = ShiftedFactor::analyze(asm.k.as_ref(), asm.m.as_ref(), true, Par::Seq).unwrap().symbolic;
         let values = numeric(&sym, &a, FactorKind::Llt);
@@ -818,13 +815,7 @@ mod tests {
             );
         }
         let reps: usize = std::env::var("TILED_REPS").ok().and_then(|s| s.parse().ok()).unwrap_or(20);
-        let time = |f: &mut dyn FnMut()| {
-            let t = std::time::Instant::now();
-            for _ in 0..reps {
-                f();
-            }
-            t.elapsed().as_secs_f64() / reps as f64 * 1e3
-        };
+        let time = |f: &mut dyn FnMut()| time_ms(reps, f);
         let mut b = random_rhs(a.nrows(), LANES);
         let mut tbuf = MemBuffer::new(TiledFactor::scratch(a.nrows()));
         let tiled_ms = time(&mut || tiled.solve_in_place(b.as_mut(), MemStack::new(&mut tbuf)));
