@@ -30,8 +30,8 @@ struct ShiftedPattern {
     symbolic: SymbolicSparseColMat<usize>,
     /// (slot, index into K values)
     k_map: Vec<(usize, usize)>,
-    /// (slot, index into M values)
-    m_map: Vec<(usize, usize)>,
+    /// (slot, index into M values); `None` when M's pattern is K's and `k_map` serves both.
+    m_map: Option<Vec<(usize, usize)>>,
 }
 
 impl ShiftedPattern {
@@ -67,8 +67,7 @@ impl ShiftedPattern {
             col_ptr.push(row_idx.len());
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let map: Vec<(usize, usize)> = src.into_iter().enumerate().collect();
-        Some(Self { symbolic, k_map: map.clone(), m_map: map })
+        Some(Self { symbolic, k_map: src.into_iter().enumerate().collect(), m_map: None })
     }
 
     /// The general union of the upper triangles of K and M (plus the diagonal).
@@ -118,7 +117,7 @@ impl ShiftedPattern {
         }
         // SAFETY-free: new_checked validates sorted, in-range, non-duplicate row indices.
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Self { symbolic, k_map, m_map }
+        Self { symbolic, k_map, m_map: Some(m_map) }
     }
 
     /// Values of K − σM in this pattern.
@@ -128,7 +127,7 @@ impl ShiftedPattern {
         for &(s, i) in &self.k_map {
             out[s] += k[i];
         }
-        for &(s, i) in &self.m_map {
+        for &(s, i) in self.m_map.as_ref().unwrap_or(&self.k_map) {
             out[s] -= sigma * m[i];
         }
     }
@@ -253,7 +252,7 @@ impl<'a> ShiftedFactor<'a> {
     /// Bytes of the shifted pattern and its maps from K and M (held for the whole solve).
     pub fn pattern_bytes(&self) -> u64 {
         let entries = self.pattern.symbolic.row_idx().len() + self.pattern.symbolic.col_ptr().len();
-        let maps = (self.pattern.k_map.len() + self.pattern.m_map.len()) * 16;
+        let maps = (self.pattern.k_map.len() + self.pattern.m_map.as_ref().map_or(0, Vec::len)) * 16;
         (entries * 8 + maps) as u64
     }
 
@@ -441,34 +440,16 @@ mod tests {
     /// split is fixed at two tasks), so solves stay independent of the thread count.
     #[test]
     fn parallel_cholesky_does_not_depend_on_the_thread_count() {
-        let mesh = modal_mesh::to_quadratic(&modal_mesh::generate::box_mesh([0.2, 0.15, 0.1], [6, 5, 4]));
-        let mat = modal_fem::Material::custom(200e9, 0.3, 7850.0, 0.0, 0.0).unwrap();
-        let a = modal_fem::assemble(&mesh, &mat).unwrap();
+        let a = crate::test_support::steel_box([6, 5, 4]);
         let factor_on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let mut f = ShiftedFactor::analyze(a.k.as_ref(), a.m.as_ref(), true, Par::Seq).unwrap();
                 f.parallel_llt_nnz = 0;
                 assert!(matches!(f.llt_par(), Par::Rayon(_)));
-                f.fill(-1e3).unwrap();
-                let par = f.llt_par();
-                let req = f.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-                let mut buf = MemBuffer::new(req);
-                let am = SparseColMatRef::new(f.pattern.symbolic.as_ref(), &f.a_values);
-                let reg = LltRegularization::default();
-                let mut values = std::mem::take(&mut f.values);
-                f.symbolic
-                    .factorize_numeric_llt(
-                        &mut values,
-                        am,
-                        Side::Upper,
-                        reg,
-                        par,
-                        MemStack::new(&mut buf),
-                        Default::default(),
-                    )
-                    .unwrap();
-                values
+                f.factor_llt(-1e3).unwrap();
+                // The factor as the solves use it: tiles, or faer's values if simplicial.
+                f.tiled.take().map_or_else(|| std::mem::take(&mut f.values), TiledFactor::into_values)
             })
         };
         let one = factor_on(1);
