@@ -157,8 +157,6 @@ pub struct ShiftedFactor<'a> {
     parallel_llt_nnz: usize,
     /// The current factor repacked for solves (then `values` is empty).
     pub(crate) tiled: Option<TiledFactor>,
-    /// Length of the tiled values (0 for a simplicial factor).
-    tiled_len: usize,
     shift: f64,
     par: Par,
     /// Ordering that was used.
@@ -200,7 +198,6 @@ impl<'a> ShiftedFactor<'a> {
                 (s, OrderingUsed::Amd)
             }
         };
-        let tiled_len = TiledFactor::packed_len(&symbolic).unwrap_or(0);
         Ok(Self {
             k,
             m,
@@ -210,7 +207,6 @@ impl<'a> ShiftedFactor<'a> {
             a_values: Vec::new(),
             kind: None,
             tiled: None,
-            tiled_len,
             parallel_llt_nnz: PARALLEL_LLT_NNZ,
             shift: f64::NAN,
             par,
@@ -245,7 +241,8 @@ impl<'a> ShiftedFactor<'a> {
             .or(self.symbolic.factorize_numeric_llt_scratch::<f64>(self.llt_par(), Default::default()))
             .size_bytes();
         let a = self.pattern.symbolic.row_idx().len() * 8 * 2;
-        let values = self.factor_nnz().max(self.tiled_len) * 8;
+        let tiled = TiledFactor::packed_len(&self.symbolic).unwrap_or(0);
+        let values = self.factor_nnz().max(tiled) * 8;
         (values + scratch + a) as u64
     }
 
