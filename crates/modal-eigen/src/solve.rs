@@ -162,6 +162,8 @@ fn solve_validated(
     let mut known = Known::default();
     let below_known = if low_shift { elastic_below } else { 0 };
     let mut wanted = below_known + opts.max_modes;
+    // After an inertia mismatch: the check shift and how many eigenvalues below it are missing.
+    let mut missing: Option<(f64, usize)> = None;
     let cap = opts.max_modes;
     let mut counters = Counters::default();
     let mut searches = 0usize;
@@ -185,6 +187,13 @@ fn solve_validated(
         let ncv = basis_size(nev, block).min(free.saturating_sub(block));
         let known_before = known.lambdas.clone();
         let enough = |l: &[f64]| -> bool {
+            if let Some((sig, count)) = missing {
+                // A repeated search looks for the missed modes only: it may stop once it has
+                // them, or once its converged prefix passes σ' without them (then the count
+                // decides again). The band's cap is already met by the known modes.
+                let below = l.iter().filter(|&&x| x < sig).count();
+                return below >= count || l.iter().any(|&x| x >= sig) || l.len() >= free;
+            }
             let mut all: Vec<f64> = known_before.iter().chain(l.iter()).cloned().collect();
             all.sort_by(f64::total_cmp);
             let in_band = all.iter().filter(|&&x| x >= lam_lo && x <= lam_hi).count();
@@ -290,6 +299,7 @@ fn solve_validated(
             stats.factorizations += 1;
         }
         wanted = nu_hi - found + block;
+        missing = Some((sigma_hi, nu_hi - found));
     }
 }
 
