@@ -298,6 +298,9 @@ pub fn orthogonalize(
     mbasis: MatRef<'_, f64>,
     mut z: MatMut<'_, f64>,
 ) -> Mat<f64> {
+    if z.ncols() <= crate::cgs::WIDTH && crate::cgs::available() {
+        return orthogonalize_rows(defl, basis, mbasis, z);
+    }
     let mut coeffs = Mat::<f64>::zeros(basis.ncols(), z.ncols());
     for _ in 0..2 {
         defl.project_out(z.rb_mut());
@@ -307,6 +310,32 @@ pub fn orthogonalize(
             coeffs += &c;
         }
     }
+    coeffs
+}
+
+/// [`orthogonalize`] with the row-major kernels of [`crate::cgs`] (blocks of ≤ 8 columns):
+/// the block is transposed once for all four products of each pass.
+fn orthogonalize_rows(
+    defl: &Deflation,
+    basis: MatRef<'_, f64>,
+    mbasis: MatRef<'_, f64>,
+    z: MatMut<'_, f64>,
+) -> Mat<f64> {
+    use crate::cgs::{gram, subtract_product, RowBlock};
+    let mut rows = RowBlock::from_mat(z.rb());
+    let mut coeffs = Mat::<f64>::zeros(basis.ncols(), z.ncols());
+    for _ in 0..2 {
+        if defl.len() > 0 {
+            let c = gram(defl.mv.as_ref(), &rows);
+            subtract_product(defl.v.as_ref(), c.as_ref(), &mut rows);
+        }
+        if basis.ncols() > 0 {
+            let c = gram(mbasis, &rows);
+            subtract_product(basis, c.as_ref(), &mut rows);
+            coeffs += &c;
+        }
+    }
+    rows.write_to(z);
     coeffs
 }
 

@@ -20,6 +20,7 @@
 //! would otherwise differ from fresh solves, and scenes promise the same WAV either way).
 
 mod block;
+mod cgs;
 mod factor;
 mod krylov;
 mod ordering;

@@ -23,11 +23,23 @@ pub trait Kernel {
     fn run<F: MulAdd>(self) -> Self::Output;
 }
 
+/// Whether this CPU runs the AVX-512 variant.
+pub fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Runs `kernel` with the best variant this CPU supports.
 pub fn dispatch<K: Kernel>(kernel: K) -> K::Output {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("fma") {
+        if has_avx512() {
             // SAFETY: the features were detected on this CPU.
             return unsafe { run_avx512(kernel) };
         }

@@ -30,8 +30,9 @@ pub use pipeline::{
 /// within a repeated eigenvalue follows every rounding.
 /// History: 2 — session 3's parallel sparse/dense products in modal-eigen; 3 — the
 /// block solves run on the factor repacked into row tiles (`modal-eigen` `tiled`); 4 — the
-/// Cholesky factorization of large factors runs in parallel (two tasks).
-pub const SOLVER_VERSION: &str = "modal-precompute-4";
+/// Cholesky factorization of large factors runs in parallel (two tasks); 5 — Gram–Schmidt
+/// products of the Krylov blocks on a row-major copy (`modal-eigen` `cgs`).
+pub const SOLVER_VERSION: &str = "modal-precompute-5";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]
