@@ -11,8 +11,9 @@
 //!
 //! Completeness proof: Sylvester's law of inertia on an LDLᵀ of `K − σ'M` with σ' just above
 //! the highest returned mode. With [`EigenOptions::overlap_check`] this factorization starts
-//! on a second thread as soon as the Ritz values accurate to `krylov::EARLY_GATE` determine
-//! σ', overlapping the rest of the iteration (spectrum slicing: the count needs no solves).
+//! as a second task of the solver's pool as soon as the Ritz values accurate to
+//! `krylov::EARLY_GATE` determine σ', overlapping the rest of the iteration (spectrum
+//! slicing: the count needs no solves).
 //! It is accepted only if σ' lies above every returned mode and the count equals the modes
 //! known below σ'; otherwise the check is factored again at the final σ'.
 
@@ -214,19 +215,26 @@ fn solve_validated(
             let band = Band { lo: lam_lo, hi: lam_hi, cap };
             let early_ok = overlap && searches == 1;
             let f = &factor;
-            let (out, early) = std::thread::scope(|scope| {
-                let mut handle = None;
+            // The early count runs as a task of the solver's pool: on two threads it takes
+            // one worker while the search's parallel halves run inline on the other (an OS
+            // thread of its own would time-slice against both workers); on one thread it runs
+            // after the search.
+            let slot = std::sync::OnceLock::new();
+            let out = rayon::in_place_scope(|scope| {
+                let mut spawned = false;
                 let mut early = |l: &[f64], next: f64| {
-                    if early_ok && handle.is_none() {
+                    if early_ok && !spawned {
+                        spawned = true;
                         let sig = band.early_check_shift(&known_before, l, next);
-                        handle = Some((sig, scope.spawn(move || f.inertia_at(sig))));
+                        let slot = &slot;
+                        scope.spawn(move |_| {
+                            let _ = slot.set((sig, f.inertia_at(sig)));
+                        });
                     }
                 };
-                let out = search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, progress);
-                let early =
-                    handle.and_then(|(sig, h)| h.join().ok().and_then(Result::ok).map(|nu| (sig, nu)));
-                (out, early)
+                search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, progress)
             });
+            let early = slot.into_inner().and_then(|(sig, r)| r.ok().map(|nu| (sig, nu)));
             (out?, early)
         };
         known.merge(out.lambdas, out.vectors, out.residuals);
