@@ -78,6 +78,21 @@ pub struct KsOutput {
     pub block_solves: usize,
 }
 
+/// The memory of a search's basis V (`n × columns`) and of its M-image (kept alongside V:
+/// the operator input and every M-inner product come from it), made — and faulted in — ahead
+/// of the search if the caller has a core to spare (see `solve`).
+pub struct BasisStorage {
+    v: Mat<f64>,
+    mv: Mat<f64>,
+}
+
+impl BasisStorage {
+    /// Zeroed storage for `columns` basis columns (including the residual block).
+    pub fn new(n: usize, columns: usize) -> Self {
+        Self { v: Mat::zeros(n, columns), mv: Mat::zeros(n, columns) }
+    }
+}
+
 /// Counters threaded through searches for progress reporting.
 #[derive(Default)]
 pub struct Counters {
@@ -129,8 +144,9 @@ fn rayleigh_ritz(h: &Mat<f64>, k: usize, p: usize) -> Option<Ritz> {
     Some(Ritz { theta, s, est })
 }
 
-/// Runs one search. `enough(λs)` receives the λ of the converged prefix (ascending λ − σ)
-/// and says whether the search may stop. `early(λs, λ_next)` is called whenever the prefix
+/// Runs one search (in `storage` if it has the shape `n × (ncv + block)`). `enough(λs)`
+/// receives the λ of the converged prefix (ascending λ − σ) and says whether the search may
+/// stop. `early(λs, λ_next)` is called whenever the prefix
 /// of Ritz values accurate to [`EARLY_GATE`] already satisfies `enough` (λ_next: the next
 /// Ritz value, +∞ if none), so the caller can start the inertia check of the final shift
 /// while the iteration polishes the vectors.
@@ -144,6 +160,7 @@ pub fn search(
     enough: &dyn Fn(&[f64]) -> bool,
     early: &mut dyn FnMut(&[f64], f64),
     counters: &mut Counters,
+    storage: Option<BasisStorage>,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<KsOutput, EigenError> {
     let n = m.nrows();
@@ -151,9 +168,10 @@ pub fn search(
     let ncv = cfg.ncv;
     let sigma = factor.shift();
     let mut rng = Rng::new(cfg.seed);
-    let mut v = Mat::<f64>::zeros(n, ncv + p);
-    // M V, kept alongside V: the operator input and every M-inner product come from it.
-    let mut mv = Mat::<f64>::zeros(n, ncv + p);
+    let BasisStorage { mut v, mut mv } = match storage {
+        Some(s) if (s.v.nrows(), s.v.ncols()) == (n, ncv + p) => s,
+        _ => BasisStorage::new(n, ncv + p),
+    };
     let mut h = Mat::<f64>::zeros(ncv + p, ncv + p);
     let mut buf = MemBuffer::try_new(factor.solve_scratch(p))
         .map_err(|_| EigenError::Factorization("out of memory for the solve workspace".into()))?;

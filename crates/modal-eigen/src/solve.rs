@@ -18,8 +18,9 @@
 //! known below σ'; otherwise the check is factored again at the final σ'.
 
 use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation, RitzSet};
+use crate::factor::CountBuffers;
 use crate::factor::ShiftedFactor;
-use crate::krylov::{attainable, residuals, search, Counters, KsConfig};
+use crate::krylov::{attainable, residuals, search, BasisStorage, Counters, KsConfig};
 use crate::types::*;
 use faer::linalg::matmul::matmul;
 use faer::sparse::SparseColMatRef;
@@ -148,10 +149,23 @@ fn solve_validated(
     };
     let mut elastic_below = nu_lo.saturating_sub(n_rigid);
     let low_shift = !count_below || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
+    let below_known = if low_shift { elastic_below } else { 0 };
+    let mut wanted = below_known + opts.max_modes;
+    // Memory the first search and the early inertia count will write, made on the second
+    // core while the Cholesky factorization keeps the first one busy (fresh pages cost ≈ 4 µs
+    // each to fault in on the machines measured; see `factor::touched`).
+    let mut prefaulted: Option<(BasisStorage, Option<CountBuffers>)> = None;
     if low_shift {
         let sigma = -lam_lo.max(SHIFT_FLOOR * lam_scale);
         stats.factorizations += 1;
-        factor.factor_llt(sigma)?;
+        let (_, ncv) = search_size(wanted, n - defl.len(), block);
+        let count = factor.count_sizes();
+        let (llt, spare) = rayon::join(
+            || factor.factor_llt(sigma),
+            || (BasisStorage::new(n, ncv + block), overlap.then(|| count.allocate().ok()).flatten()),
+        );
+        llt?;
+        prefaulted = Some(spare);
     } else {
         factor.prepare_solves();
     }
@@ -161,8 +175,6 @@ fn solve_validated(
 
     // Known eigenpairs (λ ascending after each merge).
     let mut known = Known::default();
-    let below_known = if low_shift { elastic_below } else { 0 };
-    let mut wanted = below_known + opts.max_modes;
     // After an inertia mismatch: the check shift and how many eigenvalues below it are missing.
     let mut missing: Option<(f64, usize)> = None;
     let cap = opts.max_modes;
@@ -184,8 +196,7 @@ fn solve_validated(
             None => &defl,
         };
         let free = n - defl.len();
-        let nev = wanted.min(free);
-        let ncv = basis_size(nev, block).min(free.saturating_sub(block));
+        let (nev, ncv) = search_size(wanted, free, block);
         let known_before = known.lambdas.clone();
         let enough = |l: &[f64]| -> bool {
             if let Some((sig, count)) = missing {
@@ -220,19 +231,20 @@ fn solve_validated(
             // thread of its own would time-slice against both workers); on one thread it runs
             // after the search.
             let slot = std::sync::OnceLock::new();
+            let (storage, mut count_buffers) = prefaulted.take().unzip();
             let out = rayon::in_place_scope(|scope| {
                 let mut spawned = false;
                 let mut early = |l: &[f64], next: f64| {
                     if early_ok && !spawned {
                         spawned = true;
                         let sig = band.early_check_shift(&known_before, l, next);
-                        let slot = &slot;
+                        let (slot, buffers) = (&slot, count_buffers.take().flatten());
                         scope.spawn(move |_| {
-                            let _ = slot.set((sig, f.inertia_at(sig)));
+                            let _ = slot.set((sig, f.inertia_at(sig, buffers)));
                         });
                     }
                 };
-                search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, progress)
+                search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, storage, progress)
             });
             let early = slot.into_inner().and_then(|(sig, r)| r.ok().map(|nu| (sig, nu)));
             (out?, early)
@@ -318,6 +330,12 @@ fn solve_validated(
 /// capped so that orthogonalization and memory stay linear in nev.
 fn basis_size(nev: usize, block: usize) -> usize {
     nev + nev.max((2 * nev).min(EXTRA_BASIS)).max(3 * block)
+}
+
+/// (nev, ncv) of a search for `wanted` pairs with `free` dimensions left after deflation.
+fn search_size(wanted: usize, free: usize, block: usize) -> (usize, usize) {
+    let nev = wanted.min(free);
+    (nev, basis_size(nev, block).min(free.saturating_sub(block)))
 }
 
 /// Dense n-vectors the iteration holds at its peak: the basis V and its M-image (ncv + one
