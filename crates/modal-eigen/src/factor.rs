@@ -211,10 +211,15 @@ impl<'a> ShiftedFactor<'a> {
         use_metis: bool,
         par: Par,
     ) -> Result<Self, EigenError> {
-        let pattern = ShiftedPattern::new(k, m);
-        let perm: Option<Permutation> =
-            if use_metis { metis_node_ordering(pattern.symbolic.as_ref()) } else { None };
+        // The node graph for METIS comes from K's pattern, which yields exactly the graph of
+        // the shifted pattern when K and M share it (the assembled case): METIS (≈ 75 ms at
+        // 30k DOF) then runs beside the construction of the shifted pattern (≈ 30 ms).
+        let (pattern, perm) = rayon::join(
+            || ShiftedPattern::new(k, m),
+            || if use_metis { metis_node_ordering(k.symbolic()) } else { None },
+        );
         let fail = |e: faer::sparse::FaerError| EigenError::Factorization(format!("{e:?}"));
+        let perm: Option<Permutation> = perm;
         let (symbolic, ordering) = match &perm {
             Some(p) => {
                 let pr = PermRef::new_checked(&p.fwd, &p.inv, p.fwd.len());
