@@ -22,7 +22,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, supernodal::SupernodalLdltRef, CholeskySymbolicParams, LdltRef, LltRef,
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{MatMut, Par, Side};
 
 /// Upper-triangular union pattern of K and M with maps from K and M entries to its slots.
@@ -47,27 +47,12 @@ impl ShiftedPattern {
         if ks.col_ptr() != ms.col_ptr() || ks.row_idx() != ms.row_idx() || ks.col_nnz().is_some() {
             return None;
         }
-        let n = k.ncols();
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        let mut src = Vec::new();
-        col_ptr.push(0usize);
-        for j in 0..n {
-            let range = ks.col_range(j);
-            let rows = &ks.row_idx()[range.clone()];
-            if !rows.windows(2).all(|w| w[0] < w[1]) {
-                return None;
-            }
-            let upper = rows.partition_point(|&r| r <= j);
-            if upper == 0 || rows[upper - 1] != j {
-                return None;
-            }
-            row_idx.extend_from_slice(&rows[..upper]);
-            src.extend(range.start..range.start + upper);
-            col_ptr.push(row_idx.len());
-        }
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Some(Self { symbolic, k_map: src.into_iter().enumerate().collect(), m_map: None })
+        let symbolic = upper_triangle(ks)?;
+        // Slot i of column j is entry i of K's column j.
+        let upper_ptr = symbolic.col_ptr();
+        let src =
+            (0..k.ncols()).flat_map(|j| ks.col_ptr()[j]..ks.col_ptr()[j] + (upper_ptr[j + 1] - upper_ptr[j]));
+        Some(Self { k_map: src.enumerate().collect(), symbolic, m_map: None })
     }
 
     /// The general union of the upper triangles of K and M (plus the diagonal).
@@ -137,6 +122,82 @@ impl ShiftedPattern {
 /// [`ShiftedFactor::llt_par`]).
 const PARALLEL_LLT_NNZ: usize = 40_000_000;
 
+/// Fill-reducing ordering and symbolic Cholesky factorization of the upper pattern of
+/// `K − σM`. It depends on the pattern only, so a caller can make it from the mesh's
+/// connectivity while K and M are being assembled ([`crate::solve_analyzed`]).
+pub struct Analysis {
+    /// Upper triangle (with the diagonal) of the pattern, in faer's sorted form.
+    upper: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    ordering: OrderingUsed,
+}
+
+impl Analysis {
+    /// Analysis of the symmetric pattern `pattern` (full or upper storage, sorted rows, every
+    /// diagonal entry present). `use_metis`: METIS nested dissection of the node graph when
+    /// the DOFs come in threes (else, or if METIS fails, faer's AMD).
+    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, use_metis: bool) -> Result<Self, EigenError> {
+        let (upper, perm) = rayon::join(
+            || upper_triangle(pattern),
+            || if use_metis { metis_node_ordering(pattern) } else { None },
+        );
+        let upper = upper.ok_or_else(|| {
+            EigenError::Factorization("pattern: unsorted rows or a missing diagonal entry".into())
+        })?;
+        Self::with_ordering(upper, perm)
+    }
+
+    /// Analysis of an upper pattern (with diagonal).
+    fn of_upper(upper: SymbolicSparseColMat<usize>, use_metis: bool) -> Result<Self, EigenError> {
+        let perm = if use_metis { metis_node_ordering(upper.as_ref()) } else { None };
+        Self::with_ordering(upper, perm)
+    }
+
+    fn with_ordering(
+        upper: SymbolicSparseColMat<usize>,
+        perm: Option<Permutation>,
+    ) -> Result<Self, EigenError> {
+        let fail = |e: faer::sparse::FaerError| EigenError::Factorization(format!("{e:?}"));
+        let (ordering, used) = match &perm {
+            Some(p) => (
+                SymmetricOrdering::Custom(PermRef::new_checked(&p.fwd, &p.inv, p.fwd.len())),
+                OrderingUsed::Metis,
+            ),
+            None => (SymmetricOrdering::Amd, OrderingUsed::Amd),
+        };
+        let symbolic = factorize_symbolic_cholesky(
+            upper.as_ref(),
+            Side::Upper,
+            ordering,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(fail)?;
+        Ok(Self { upper, symbolic, ordering: used })
+    }
+}
+
+/// The upper triangle of a symmetric pattern; `None` unless every column's rows are sorted
+/// and hold the diagonal.
+fn upper_triangle(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<SymbolicSparseColMat<usize>> {
+    let n = pattern.ncols();
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0usize);
+    for j in 0..n {
+        let rows = pattern.row_idx_of_col_raw(j);
+        if !rows.windows(2).all(|w| w[0] < w[1]) {
+            return None;
+        }
+        let upper = rows.partition_point(|&r| r <= j);
+        if upper == 0 || rows[upper - 1] != j {
+            return None;
+        }
+        row_idx.extend_from_slice(&rows[..upper]);
+        col_ptr.push(row_idx.len());
+    }
+    SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx).into()
+}
+
 /// Sizes of the buffers of one inertia count, from the symbolic analysis alone: the buffers
 /// can be made on another core while the factor is busy.
 #[derive(Clone, Copy, Debug)]
@@ -204,45 +265,33 @@ pub struct ShiftedFactor<'a> {
 }
 
 impl<'a> ShiftedFactor<'a> {
-    /// Ordering and symbolic factorization. `use_metis` requests METIS (falls back to AMD).
+    /// Ordering and symbolic factorization (`given`: made beforehand from the pattern of K
+    /// by [`Analysis::new`], used if it is the pattern of `K − σM`). `use_metis` requests
+    /// METIS (falls back to AMD).
     pub fn analyze(
         k: SparseColMatRef<'a, usize, f64>,
         m: SparseColMatRef<'a, usize, f64>,
+        given: Option<Analysis>,
         use_metis: bool,
         par: Par,
     ) -> Result<Self, EigenError> {
-        // The node graph for METIS comes from K's pattern, which yields exactly the graph of
-        // the shifted pattern when K and M share it (the assembled case): METIS (≈ 75 ms at
-        // 30k DOF) then runs beside the construction of the shifted pattern (≈ 30 ms).
-        let (pattern, perm) = rayon::join(
-            || ShiftedPattern::new(k, m),
-            || if use_metis { metis_node_ordering(k.symbolic()) } else { None },
-        );
-        let fail = |e: faer::sparse::FaerError| EigenError::Factorization(format!("{e:?}"));
-        let perm: Option<Permutation> = perm;
-        let (symbolic, ordering) = match &perm {
-            Some(p) => {
-                let pr = PermRef::new_checked(&p.fwd, &p.inv, p.fwd.len());
-                let s = factorize_symbolic_cholesky(
-                    pattern.symbolic.as_ref(),
-                    Side::Upper,
-                    SymmetricOrdering::Custom(pr),
-                    CholeskySymbolicParams::default(),
-                )
-                .map_err(fail)?;
-                (s, OrderingUsed::Metis)
-            }
-            None => {
-                let s = factorize_symbolic_cholesky(
-                    pattern.symbolic.as_ref(),
-                    Side::Upper,
-                    SymmetricOrdering::Amd,
-                    CholeskySymbolicParams::default(),
-                )
-                .map_err(fail)?;
-                (s, OrderingUsed::Amd)
-            }
+        // Without a given analysis, one is made from K's pattern beside the construction of
+        // the shifted pattern: when K and M share their pattern (the assembled case) the two
+        // coincide, and METIS (≈ 75 ms at 30k DOF) overlaps the shifted pattern (≈ 30 ms).
+        let (pattern, analysis) = match given {
+            Some(a) => (ShiftedPattern::new(k, m), Ok(a)),
+            None => rayon::join(|| ShiftedPattern::new(k, m), || Analysis::new(k.symbolic(), use_metis)),
         };
+        let analysis = match analysis {
+            Ok(a)
+                if a.upper.col_ptr() == pattern.symbolic.col_ptr()
+                    && a.upper.row_idx() == pattern.symbolic.row_idx() =>
+            {
+                a
+            }
+            _ => Analysis::of_upper(pattern.symbolic.clone(), use_metis)?,
+        };
+        let Analysis { symbolic, ordering, .. } = analysis;
         Ok(Self {
             k,
             m,
@@ -492,7 +541,7 @@ mod tests {
         let factor_on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let mut f = ShiftedFactor::analyze(a.k.as_ref(), a.m.as_ref(), true, Par::Seq).unwrap();
+                let mut f = ShiftedFactor::analyze(a.k.as_ref(), a.m.as_ref(), None, true, Par::Seq).unwrap();
                 f.parallel_llt_nnz = 0;
                 assert!(matches!(f.llt_par(), Par::Rayon(_)));
                 f.factor_llt(-1e3).unwrap();

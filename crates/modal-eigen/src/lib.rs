@@ -31,6 +31,7 @@ mod test_support;
 mod tiled;
 mod types;
 
+pub use factor::Analysis;
 pub use krylov::attainable as residual_bound;
-pub use solve::solve;
+pub use solve::{analyze, solve, solve_analyzed};
 pub use types::*;

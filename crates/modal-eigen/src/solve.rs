@@ -18,8 +18,8 @@
 //! known below σ'; otherwise the check is factored again at the final σ'.
 
 use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation, RitzSet};
-use crate::factor::CountBuffers;
 use crate::factor::ShiftedFactor;
+use crate::factor::{Analysis, CountBuffers};
 use crate::krylov::{attainable, residuals, search, BasisStorage, Counters, KsConfig};
 use crate::types::*;
 use faer::linalg::matmul::matmul;
@@ -54,6 +54,20 @@ pub fn solve(
     opts: &EigenOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<EigenSolution, EigenError> {
+    solve_analyzed(k, m, rigid_fields, opts, None, progress)
+}
+
+/// [`solve`] with the ordering and symbolic factorization made beforehand by
+/// [`crate::analyze`] from the pattern of K (e.g. while K and M were assembled); it is used
+/// if it matches the pattern of `K − σM`, else the analysis is redone.
+pub fn solve_analyzed(
+    k: &faer::sparse::SparseColMat<usize, f64>,
+    m: &faer::sparse::SparseColMat<usize, f64>,
+    rigid_fields: Option<MatRef<'_, f64>>,
+    opts: &EigenOptions,
+    analysis: Option<Analysis>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<EigenSolution, EigenError> {
     let (k, m) = (k.as_ref(), m.as_ref());
     validate(k, m, rigid_fields, opts)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -64,7 +78,7 @@ pub fn solve(
     std::thread::scope(|scope| {
         let worker = scope.spawn(move || {
             pool.install(move || {
-                solve_validated(k, m, rigid_fields, opts, &mut |p| {
+                solve_validated(k, m, rigid_fields, opts, analysis, &mut |p| {
                     // The receiver lives until this thread ends.
                     let _ = events.send(p);
                 })
@@ -83,6 +97,7 @@ fn solve_validated(
     m: SparseColMatRef<'_, usize, f64>,
     rigid_fields: Option<MatRef<'_, f64>>,
     opts: &EigenOptions,
+    analysis: Option<Analysis>,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<EigenSolution, EigenError> {
     let n = k.nrows();
@@ -111,7 +126,7 @@ fn solve_validated(
     progress(Progress::PhaseStart(Phase::Symbolic));
     let t = Instant::now();
     let use_metis = matches!(opts.ordering, Ordering::Metis | Ordering::Auto);
-    let mut factor = ShiftedFactor::analyze(k, m, use_metis, par)?;
+    let mut factor = ShiftedFactor::analyze(k, m, analysis, use_metis, par)?;
     stats.symbolic_s = t.elapsed().as_secs_f64();
     stats.ordering = Some(factor.ordering);
     stats.factor_nnz = factor.factor_nnz();
@@ -494,6 +509,16 @@ fn dense_all(
     matmul(w.as_mut(), Accum::Replace, q, u.as_ref(), 1.0, Par::Seq);
     let residuals = residuals(k, m, &lambdas, w.as_ref());
     Ok(crate::krylov::KsOutput { lambdas, vectors: w, residuals, restarts: 0, block_solves: 0 })
+}
+
+/// Ordering and symbolic factorization of the pattern of K (full or upper storage, sorted
+/// rows, every diagonal entry present) for [`solve_analyzed`]: they depend on the pattern
+/// only, so they can be made while K and M are assembled.
+pub fn analyze(
+    pattern: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    ordering: Ordering,
+) -> Result<Analysis, EigenError> {
+    Analysis::new(pattern, matches!(ordering, Ordering::Metis | Ordering::Auto))
 }
 
 /// maxᵢ Kᵢᵢ / Mᵢᵢ, an estimate of the top of the spectrum; errors on Mᵢᵢ ≤ 0.

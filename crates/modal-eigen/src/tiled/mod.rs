@@ -800,7 +800,8 @@ mod tests {
     fn tiled_solve_speed() {
         let asm = steel_box([14, 11, 7]);
         let a = &asm.k + &(&asm.m * faer::Scale(1e-3));
-        let sym = ShiftedFactor::analyze(asm.k.as_ref(), asm.m.as_ref(), true, Par::Seq).unwrap().symbolic;
+        let sym =
+            ShiftedFactor::analyze(asm.k.as_ref(), asm.m.as_ref(), None, true, Par::Seq).unwrap().symbolic;
         let values = numeric(&sym, &a, FactorKind::Llt);
         let tiled = TiledFactor::pack(&sym, values.clone(), FactorKind::Llt).unwrap();
         if let Some(sp) = &tiled.split {
