@@ -12,6 +12,7 @@
 //! an LDLᵀ factor when the driver makes it the operator ([`ShiftedFactor::prepare_solves`]).
 
 use crate::ordering::{metis_node_ordering, Permutation};
+use crate::supernodal::Plan;
 use crate::tiled::{FactorKind, TiledFactor};
 use crate::types::{EigenError, OrderingUsed};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -127,9 +128,11 @@ const PARALLEL_LLT_NNZ: usize = 40_000_000;
 /// connectivity while K and M are being assembled ([`crate::solve_analyzed`]).
 pub struct Analysis {
     /// Upper triangle (with the diagonal) of the pattern, in faer's sorted form.
-    upper: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicCholesky<usize>,
+    pub(crate) upper: SymbolicSparseColMat<usize>,
+    pub(crate) symbolic: SymbolicCholesky<usize>,
     ordering: OrderingUsed,
+    /// The two-core numeric factorization (`None`: faer's).
+    plan: Option<Plan>,
 }
 
 impl Analysis {
@@ -172,7 +175,14 @@ impl Analysis {
             CholeskySymbolicParams::default(),
         )
         .map_err(fail)?;
-        Ok(Self { upper, symbolic, ordering: used })
+        // Our two-core factorization where faer's runs on one core (see `supernodal`).
+        let plan = match (symbolic.raw(), symbolic.perm()) {
+            (SymbolicCholeskyRaw::Supernodal(sn), Some(perm)) if symbolic.len_val() < PARALLEL_LLT_NNZ => {
+                Plan::new(sn, perm.arrays().1, upper.as_ref(), PLAN_MIN_WORK)
+            }
+            _ => None,
+        };
+        Ok(Self { upper, symbolic, ordering: used, plan })
     }
 }
 
@@ -238,6 +248,9 @@ fn touched(len: usize) -> Result<Vec<f64>, EigenError> {
     Ok(v)
 }
 
+/// Work (multiply–adds) from which the numeric factorization is split over two cores.
+const PLAN_MIN_WORK: usize = 1 << 26;
+
 /// Kind of numeric factor held.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 enum Kind {
@@ -258,6 +271,9 @@ pub struct ShiftedFactor<'a> {
     parallel_llt_nnz: usize,
     /// The current factor repacked for solves (then `values` is empty).
     pub(crate) tiled: Option<TiledFactor>,
+    /// The two-core numeric factorization (`None`: faer's, for small trees and for factors
+    /// large enough for faer's own parallel one).
+    plan: Option<Plan>,
     shift: f64,
     par: Par,
     /// Ordering that was used.
@@ -291,10 +307,11 @@ impl<'a> ShiftedFactor<'a> {
             }
             _ => Analysis::of_upper(pattern.symbolic.clone(), use_metis)?,
         };
-        let Analysis { symbolic, ordering, .. } = analysis;
+        let Analysis { symbolic, ordering, plan, .. } = analysis;
         Ok(Self {
             k,
             m,
+            plan,
             pattern,
             symbolic,
             values: Vec::new(),
@@ -340,11 +357,12 @@ impl<'a> ShiftedFactor<'a> {
         (values + scratch + a) as u64
     }
 
-    /// Bytes of the shifted pattern and its maps from K and M (held for the whole solve).
+    /// Bytes of the shifted pattern, its maps from K and M and the two-core factorization's
+    /// plan and work space (held for the whole solve).
     pub fn pattern_bytes(&self) -> u64 {
         let entries = self.pattern.symbolic.row_idx().len() + self.pattern.symbolic.col_ptr().len();
         let maps = (self.pattern.k_map.len() + self.pattern.m_map.as_ref().map_or(0, Vec::len)) * 16;
-        (entries * 8 + maps) as u64
+        (entries * 8 + maps) as u64 + self.plan.as_ref().map_or(0, Plan::bytes)
     }
 
     /// Shift of the current factor.
@@ -384,23 +402,24 @@ impl<'a> ShiftedFactor<'a> {
     pub fn factor_llt(&mut self, sigma: f64) -> Result<(), EigenError> {
         self.kind = None;
         self.fill(sigma)?;
-        let par = self.llt_par();
-        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut buf = self.buffer(req)?;
-        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.a_values);
-        let res = self.symbolic.factorize_numeric_llt(
-            &mut self.values,
-            a,
-            Side::Upper,
-            LltRegularization::default(),
-            par,
-            MemStack::new(&mut buf),
-            Default::default(),
-        );
-        match res {
-            Ok(_) => {}
-            Err(LltError::NonPositivePivot { index }) => {
-                return Err(EigenError::NotPositiveDefinite { pivot: index })
+        if let Some(plan) = &self.plan {
+            plan.factor(&self.a_values, &mut self.values, FactorKind::Llt, sigma, true)?;
+        } else {
+            let par = self.llt_par();
+            let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+            let mut buf = self.buffer(req)?;
+            let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.a_values);
+            let res = self.symbolic.factorize_numeric_llt(
+                &mut self.values,
+                a,
+                Side::Upper,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut buf),
+                Default::default(),
+            );
+            if let Err(LltError::NonPositivePivot { index }) = res {
+                return Err(EigenError::NotPositiveDefinite { pivot: index });
             }
         }
         self.kind = Some(Kind::Llt);
@@ -432,7 +451,7 @@ impl<'a> ShiftedFactor<'a> {
         self.kind = None;
         self.fill(sigma)?;
         let mut values = std::mem::take(&mut self.values);
-        let res = self.ldlt_into(&self.a_values, &mut values, sigma);
+        let res = self.ldlt_into(&self.a_values, &mut values, sigma, true);
         self.values = values;
         res?;
         self.kind = Some(Kind::Ldlt);
@@ -451,12 +470,17 @@ impl<'a> ShiftedFactor<'a> {
         };
         debug_assert_eq!(values.len(), self.symbolic.len_val());
         self.pattern.values(self.k.val(), self.m.val(), sigma, &mut a);
-        self.ldlt_into(&a, &mut values, sigma)?;
+        self.ldlt_into(&a, &mut values, sigma, false)?;
         Ok(negative_pivots(&self.symbolic, &values))
     }
 
-    /// Numeric LDLᵀ of the pattern values `a` (of `K − σM`) into `values`.
-    fn ldlt_into(&self, a: &[f64], values: &mut [f64], sigma: f64) -> Result<(), EigenError> {
+    /// Numeric LDLᵀ of the pattern values `a` (of `K − σM`) into `values`: on two cores if
+    /// `parallel` and the plan allows, else faer's (the early inertia count runs on one core
+    /// beside the iteration, where faer's is as fast and needs no second worker).
+    fn ldlt_into(&self, a: &[f64], values: &mut [f64], sigma: f64, parallel: bool) -> Result<(), EigenError> {
+        if let (Some(plan), true) = (&self.plan, parallel) {
+            return plan.factor(a, values, FactorKind::Ldlt, sigma, true);
+        }
         let req = self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default());
         let mut buf = self.buffer(req)?;
         let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), a);

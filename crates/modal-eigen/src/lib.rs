@@ -7,11 +7,13 @@
 //! inertia proof that no eigenvalue below the check shift was missed.
 //!
 //! Method: METIS nested-dissection ordering of the node graph, one symbolic Cholesky analysis
-//! reused for every shift, shift-invert around a shift scaled to the problem, restarted block
+//! reused for every shift (it can be made from the pattern alone while K and M are assembled:
+//! [`analyze`], [`solve_analyzed`]), a numeric Cholesky split over two cores along the
+//! elimination tree, shift-invert around a shift scaled to the problem, restarted block
 //! Krylov–Schur in the M-inner product with explicit rigid-mode deflation; its block solves
 //! run on the Cholesky factor repacked into row tiles, split over two cores along the
-//! elimination tree (see [`solve`] and the module docs of `krylov`, `factor`, `tiled`,
-//! `ordering`).
+//! elimination tree, its Gram–Schmidt products on row-major blocks (see [`solve`] and the
+//! module docs of `krylov`, `factor`, `supernodal`, `tiled`, `cgs`, `ordering`).
 //!
 //! Reproducibility: for a given build and CPU the result is bit-identical whatever the
 //! thread count (parallel work is split at fixed points) and whatever else runs in the
@@ -26,6 +28,7 @@ mod krylov;
 mod ordering;
 mod simd;
 mod solve;
+mod supernodal;
 #[cfg(test)]
 mod test_support;
 mod tiled;

@@ -175,9 +175,11 @@ fn solve_validated(
         stats.factorizations += 1;
         let (_, ncv) = search_size(wanted, n - defl.len(), block);
         let count = factor.count_sizes();
-        let (llt, spare) = rayon::join(
-            || factor.factor_llt(sigma),
+        // The factorization is the second task, so an idle worker starts it at once, and
+        // its own second half is free to be taken by this one when the memory is made.
+        let (spare, llt) = rayon::join(
             || (BasisStorage::new(n, ncv + block), overlap.then(|| count.allocate().ok()).flatten()),
+            || factor.factor_llt(sigma),
         );
         llt?;
         prefaulted = Some(spare);

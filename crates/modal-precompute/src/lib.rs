@@ -31,8 +31,9 @@ pub use pipeline::{
 /// History: 2 — session 3's parallel sparse/dense products in modal-eigen; 3 — the
 /// block solves run on the factor repacked into row tiles (`modal-eigen` `tiled`); 4 — the
 /// Cholesky factorization of large factors runs in parallel (two tasks); 5 — Gram–Schmidt
-/// products of the Krylov blocks on a row-major copy (`modal-eigen` `cgs`).
-pub const SOLVER_VERSION: &str = "modal-precompute-5";
+/// products of the Krylov blocks on a row-major copy (`modal-eigen` `cgs`); 6 — our own
+/// two-core numeric Cholesky for factors below 40 M entries (`modal-eigen` `supernodal`).
+pub const SOLVER_VERSION: &str = "modal-precompute-6";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]

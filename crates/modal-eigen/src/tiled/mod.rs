@@ -34,6 +34,7 @@ use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::MatMut;
+pub(crate) use split::split as split_tree;
 use split::Split;
 use std::ops::Range;
 
