@@ -18,8 +18,7 @@
 //! known below σ'; otherwise the check is factored again at the final σ'.
 
 use crate::block::{hcat, rayleigh_ritz_kM, spmm, svqb, sym_eig, tmul, Deflation, RitzSet};
-use crate::factor::ShiftedFactor;
-use crate::factor::{Analysis, CountBuffers};
+use crate::factor::{Analysis, CountBuffers, ShiftedFactor};
 use crate::krylov::{attainable, residuals, search, BasisStorage, Counters, KsConfig};
 use crate::types::*;
 use faer::linalg::matmul::matmul;

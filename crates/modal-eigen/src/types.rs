@@ -32,17 +32,17 @@ pub struct EigenOptions {
     pub block_size: usize,
     /// Fill-reducing ordering. Default [`Ordering::Auto`].
     pub ordering: Ordering,
-    /// Solver threads (0: one per core). Sparse products run by row ranges and tall dense
-    /// products as two fixed row halves on these threads (block solves and factorizations
-    /// stay sequential); the result does not depend on the count.
-    /// Default 0.
+    /// Solver threads (0: one per core). Sparse products run by row ranges, tall dense
+    /// products as two fixed row halves, the Cholesky factorization and the block solves as
+    /// two fixed parts of the elimination tree on these threads; the result does not depend
+    /// on the count. Default 0.
     pub threads: usize,
     /// Refuse to factor if the estimated memory exceeds this many bytes.
     /// `None`: 75 % of `MemAvailable` from /proc/meminfo (no limit if unreadable).
     pub memory_limit_bytes: Option<u64>,
     /// Maximum number of Krylov–Schur restarts per search. Default 200.
     pub max_restarts: usize,
-    /// Start the upper inertia check (an LDLᵀ of `K − σ'M`) on a second thread as soon as the
+    /// Start the upper inertia check (an LDLᵀ of `K − σ'M`) as a second task as soon as the
     /// Ritz values fix σ', overlapping it with the rest of the iteration; needs one more factor
     /// in memory (skipped if that exceeds the memory limit). The proof is unchanged: if the
     /// early σ' does not fit the converged modes, the check is redone at the final σ'.
