@@ -579,7 +579,28 @@ mod tests {
     /// A steel box's analysis, its two-core plan (split however small) and the values of
     /// `K − σM` (σ relative to max Kᵢᵢ/Mᵢᵢ) on the analysis' upper pattern.
     fn setup(cells: [usize; 3], sigma_rel: f64) -> (Analysis, Plan, Vec<f64>) {
+        setup_with(steel_box(cells), sigma_rel)
+    }
+
+    /// Two disjoint copies of a box (block-diagonal K and M): an elimination forest.
+    fn two_boxes(cells: [usize; 3]) -> modal_fem::Assembly {
         let asm = steel_box(cells);
+        let n = asm.k.nrows();
+        let twice = |a: &SparseColMat<usize, f64>| {
+            let mut triplets = Vec::new();
+            for copy in 0..2 {
+                for j in 0..n {
+                    for (i, &v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+                        triplets.push(faer::sparse::Triplet::new(i + copy * n, j + copy * n, v));
+                    }
+                }
+            }
+            SparseColMat::try_new_from_triplets(2 * n, 2 * n, &triplets).unwrap()
+        };
+        modal_fem::Assembly { k: twice(&asm.k), m: twice(&asm.m) }
+    }
+
+    fn setup_with(asm: modal_fem::Assembly, sigma_rel: f64) -> (Analysis, Plan, Vec<f64>) {
         let scale = (0..asm.k.ncols())
             .map(|j| asm.k.get(j, j).copied().unwrap_or(0.0) / asm.m.get(j, j).copied().unwrap())
             .fold(0.0, f64::max);
@@ -670,6 +691,16 @@ mod tests {
             plan.factor(&a, &mut sequential, kind, 0.0, false).unwrap();
             assert!(sequential == two, "{kind:?}: the sequential order differs");
         }
+    }
+
+    #[test]
+    fn disjoint_parts_factor_like_faer() {
+        // Two roots in the elimination forest: the bins may be whole parts, the top empty.
+        let (analysis, plan, a) = setup_with(two_boxes([5, 4, 3]), -1e-6);
+        let want = faer_factor(&analysis, &a, FactorKind::Llt);
+        let mut got = vec![0.0; want.len()];
+        plan.factor(&a, &mut got, FactorKind::Llt, 0.0, true).unwrap();
+        assert!(rel_diff(&got, &want) < 1e-11, "{}", rel_diff(&got, &want));
     }
 
     #[test]
