@@ -574,7 +574,6 @@ mod tests {
     use crate::test_support::{steel_box, time_ms};
     use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
     use faer::sparse::{SparseColMat, SparseColMatRef};
-    use faer::Side;
 
     /// A steel box's analysis, its two-core plan (split however small) and the values of
     /// `K − σM` (σ relative to max Kᵢᵢ/Mᵢᵢ) on the analysis' upper pattern.
@@ -620,43 +619,8 @@ mod tests {
     }
 
     fn faer_factor(analysis: &Analysis, a: &[f64], kind: FactorKind) -> Vec<f64> {
-        let sym = &analysis.symbolic;
-        let mut values = vec![0.0; sym.len_val()];
-        let req = sym
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
-        let mut buf = MemBuffer::new(req);
         let a = SparseColMatRef::new(analysis.upper.as_ref(), a);
-        let stack = MemStack::new(&mut buf);
-        match kind {
-            FactorKind::Llt => {
-                let reg = LltRegularization::default();
-                sym.factorize_numeric_llt(
-                    &mut values,
-                    a,
-                    Side::Upper,
-                    reg,
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .unwrap();
-            }
-            FactorKind::Ldlt => {
-                let reg = LdltRegularization::default();
-                sym.factorize_numeric_ldlt(
-                    &mut values,
-                    a,
-                    Side::Upper,
-                    reg,
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .unwrap();
-            }
-        }
-        values
+        crate::test_support::faer_numeric(&analysis.symbolic, a, kind)
     }
 
     /// Largest difference relative to the largest value (NaN fails).

@@ -18,3 +18,33 @@ pub fn time_ms(reps: usize, f: &mut dyn FnMut()) -> f64 {
     }
     start.elapsed().as_secs_f64() / reps as f64 * 1e3
 }
+
+/// faer's own numeric factor (`kind`) of the upper triangle of `a` (must succeed): the
+/// reference the tiled solves and the two-core factorization are compared with.
+pub fn faer_numeric(
+    sym: &faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+    a: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    kind: crate::tiled::FactorKind,
+) -> Vec<f64> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::{ldlt::factor::LdltRegularization, llt::factor::LltRegularization};
+    use faer::{Par, Side};
+    let mut values = vec![0.0; sym.len_val()];
+    let req = sym
+        .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+        .or(sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
+    let mut buf = MemBuffer::new(req);
+    let stack = MemStack::new(&mut buf);
+    let (up, seq) = (Side::Upper, Par::Seq);
+    match kind {
+        crate::tiled::FactorKind::Llt => {
+            let reg = LltRegularization::default();
+            sym.factorize_numeric_llt(&mut values, a, up, reg, seq, stack, Default::default()).unwrap();
+        }
+        crate::tiled::FactorKind::Ldlt => {
+            let reg = LdltRegularization::default();
+            sym.factorize_numeric_ldlt(&mut values, a, up, reg, seq, stack, Default::default()).unwrap();
+        }
+    }
+    values
+}

@@ -593,8 +593,6 @@ mod tests {
     use crate::factor::ShiftedFactor;
     use crate::test_support::{steel_box, time_ms};
     use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-    use faer::linalg::cholesky::llt::factor::LltRegularization;
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymmetricOrdering,
     };
@@ -623,24 +621,7 @@ mod tests {
 
     /// faer's numeric factor of `a` (must succeed).
     fn numeric(sym: &SymbolicCholesky<usize>, a: &SparseColMat<usize, f64>, kind: FactorKind) -> Vec<f64> {
-        let mut values = vec![0.0; sym.len_val()];
-        let req = sym
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
-        let mut buf = MemBuffer::new(req);
-        let stack = MemStack::new(&mut buf);
-        let (a, up, seq) = (a.as_ref(), Side::Upper, Par::Seq);
-        match kind {
-            FactorKind::Llt => {
-                let reg = LltRegularization::default();
-                sym.factorize_numeric_llt(&mut values, a, up, reg, seq, stack, Default::default()).unwrap();
-            }
-            FactorKind::Ldlt => {
-                let reg = LdltRegularization::default();
-                sym.factorize_numeric_ldlt(&mut values, a, up, reg, seq, stack, Default::default()).unwrap();
-            }
-        }
-        values
+        crate::test_support::faer_numeric(sym, a.as_ref(), kind)
     }
 
     /// A⁻¹ b with faer's own solve.
