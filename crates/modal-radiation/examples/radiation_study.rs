@@ -9,7 +9,7 @@ fn main() {
     for subdiv in [2, 3] {
         let (v, t) = shapes::icosphere(subdiv);
         let mesh = BoundaryMesh::new(v.iter().map(|p| p.map(|x| a * x)).collect(), &t).unwrap();
-        for ka in [0.2, 3.0, std::f64::consts::PI] {
+        for ka in [0.2, 1.0, 3.0, std::f64::consts::PI, 6.0] {
             let k: f64 = ka / a;
             let f = k * air.sound_speed_m_s / (2.0 * std::f64::consts::PI);
             for form in [Formulation::BurtonMiller, Formulation::Conventional] {
@@ -18,7 +18,7 @@ fn main() {
                     solve(&mesh, air, f, &[vec![c64::new(1.0, 0.0); mesh.len()]], form).unwrap().remove(0);
                 let dt = t0.elapsed().as_secs_f64();
                 let x = [0.13, 0.11, 0.17];
-                let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] as f64).sqrt();
+                let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
                 let exact = c64::new(0.0, air.impedance()) * spherical_hankel(0, k * r)[0]
                     / spherical_hankel_derivative(0, ka)[0];
                 let got = s.pressure_at(&mesh, x).unwrap();

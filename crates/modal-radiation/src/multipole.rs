@@ -58,10 +58,10 @@ impl Multipole {
         let h = spherical_hankel(self.order, self.wavenumber * r);
         let y = spherical_harmonics(self.order, d);
         let mut p = c64::new(0.0, 0.0);
-        for l in 0..=self.order {
+        for (l, hl) in h.iter().enumerate() {
             for m in -(l as i64)..=l as i64 {
                 let i = lm_index(l, m);
-                p += self.coefficients[i] * h[l] * y[i];
+                p += self.coefficients[i] * hl * y[i];
             }
         }
         p
