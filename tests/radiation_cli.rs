@@ -54,7 +54,7 @@ fn sphere_modes_radiate_as_single_multipoles_and_torsional_modes_are_silent() {
     let modes = json["modes"].as_array().unwrap();
     assert!(!modes.is_empty());
 
-    let bank = ModeBank::load(&dir.path().join("sphere.bank")).unwrap();
+    let bank = ModeBank::load(dir.path().join("sphere.bank")).unwrap();
     let mesh = boundary_mesh(&bank).unwrap();
     let air = Air::default();
     let (mut spheroidal, mut torsional) = (Vec::new(), Vec::new());
@@ -201,7 +201,7 @@ fn pressure_scales_with_air_density_and_skips_inaudible_modes() {
     }
     // Every mode of this bank lies above 20 Hz; a 1 kHz ceiling skips the higher ones.
     let capped = run(&["--max-freq", "1000"]);
-    let bank = ModeBank::load(&dir.path().join("sphere.bank")).unwrap();
+    let bank = ModeBank::load(dir.path().join("sphere.bank")).unwrap();
     let skipped: Vec<u64> =
         capped["modes_skipped"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
     for i in [0u64, 6] {

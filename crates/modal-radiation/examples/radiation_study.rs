@@ -17,7 +17,7 @@ fn main() {
                 let s =
                     solve(&mesh, air, f, &[vec![c64::new(1.0, 0.0); mesh.len()]], form).unwrap().remove(0);
                 let dt = t0.elapsed().as_secs_f64();
-                let x = [0.13, 0.11, 0.17];
+                let x: [f64; 3] = [0.13, 0.11, 0.17];
                 let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
                 let exact = c64::new(0.0, air.impedance()) * spherical_hankel(0, k * r)[0]
                     / spherical_hankel_derivative(0, ka)[0];

@@ -22,11 +22,14 @@ fn far_points(r: f64) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// A normal-velocity field as a function of the outward normal.
+type Field = fn([f64; 3]) -> c64;
+
 #[test]
 fn boundary_elements_agree_with_equivalent_sources_on_ellipsoids() {
     let air = Air::default();
     // A dipole-like, a quadrupole-like and a lumpy field; low and mid ka.
-    let fields: [(&str, fn([f64; 3]) -> c64); 3] = [
+    let fields: [(&str, Field); 3] = [
         ("dipole", |n| c64::new(n[2], 0.0)),
         ("quadrupole", |n| c64::new(n[0] * n[1], 0.0)),
         ("lumpy", |n| c64::new(1.0 + n[0] - 0.5 * n[1] * n[2], 0.3 * n[2])),
