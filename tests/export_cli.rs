@@ -125,7 +125,8 @@ fn faust_model_compiles_with_the_faust_compiler_when_installed() {
     };
     let dir = temp_dir();
     bar_bank(dir.path());
-    let args = ["export", "bar.bank", "--faust", "bar.lib", "--at", "0.05,0.01,0.01", "--at", "0.3,0.01,0.01"];
+    let args =
+        ["export", "bar.bank", "--faust", "bar.lib", "--at", "0.05,0.01,0.01", "--at", "0.3,0.01,0.01"];
     modal(dir.path(), &args).ok();
     let dsp = "import(\"stdfaust.lib\");\nimport(\"bar.lib\");\n\
                process = button(\"gate\") : ba.impulsify : modalModel(nentry(\"exPos\",0,0,1,1),1);\n";

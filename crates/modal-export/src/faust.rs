@@ -121,8 +121,7 @@ impl FaustModel {
         let mut gains = Vec::with_capacity(at.len());
         let mut positions = Vec::with_capacity(at.len());
         for (index, &point) in at.iter().enumerate() {
-            let hit =
-                model.locate(point).map_err(|source| ExportError::Position { index, point, source })?;
+            let hit = model.locate(point).map_err(|source| ExportError::Position { index, point, source })?;
             model.shapes_dot(&hit, hit.normal, &mut dots);
             let row: Vec<f64> = bank_modes.iter().map(|&i| dots[i].abs()).collect();
             let scale = row.iter().cloned().fold(0.0, f64::max);
@@ -175,8 +174,15 @@ impl FaustModel {
             writeln!(out, "// {} overdamped modes (no oscillation) are left out.", self.skipped_modes)?;
         }
         writeln!(out, "// Frequencies: damped [Hz]. T60 = ln(1000)/decay rate [s].")?;
-        writeln!(out, "// Gains: |phi(x).n| at each position divided by that position's largest (as mesh2faust).")?;
-        writeln!(out, "// Usage: excitation : {name}(exPos,t60Scale) : _   (exPos 0..{}, t60Scale 1 = the bank's T60s)", p - 1)?;
+        writeln!(
+            out,
+            "// Gains: |phi(x).n| at each position divided by that position's largest (as mesh2faust)."
+        )?;
+        writeln!(
+            out,
+            "// Usage: excitation : {name}(exPos,t60Scale) : _   (exPos 0..{}, t60Scale 1 = the bank's T60s)",
+            p - 1
+        )?;
         writeln!(out, "import(\"stdfaust.lib\");")?;
         writeln!(out)?;
         writeln!(
