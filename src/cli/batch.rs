@@ -69,7 +69,8 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     if args.jobs == 0 {
         bail!("--jobs must be at least 1");
     }
-    let (shard, from) = Shard::select(args.shard.as_deref(), args.shard_count, |name| std::env::var(name).ok())?;
+    let (shard, from) =
+        Shard::select(args.shard.as_deref(), args.shard_count, |name| std::env::var(name).ok())?;
     let manifest = Manifest::load(&args.manifest)?;
     let (all, warnings) = manifest.resolve()?;
     warnings.iter().for_each(|w| warn(w));
@@ -131,14 +132,19 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
         );
     }
     if failed > 0 {
-        bail!("{failed} of {} assets failed (their errors are in {})", catalogue.assets.len(), path.display());
+        bail!(
+            "{failed} of {} assets failed (their errors are in {})",
+            catalogue.assets.len(),
+            path.display()
+        );
     }
     Ok(())
 }
 
 fn progress_bar(len: u64, prefix: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
-    let template = format!("{prefix}{{bar:30}} {{pos}}/{{len}} [{{elapsed_precise}}, ETA {{eta_precise}}] {{wide_msg}}");
+    let template =
+        format!("{prefix}{{bar:30}} {{pos}}/{{len}} [{{elapsed_precise}}, ETA {{eta_precise}}] {{wide_msg}}");
     bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
     bar.enable_steady_tick(Duration::from_millis(250));
     bar
@@ -147,11 +153,19 @@ fn progress_bar(len: u64, prefix: &str) -> ProgressBar {
 /// The summary table: one line per asset, failures with their message.
 fn write_table(catalogue: &Catalogue, out: &mut impl Write) -> std::io::Result<()> {
     let width = catalogue.assets.iter().map(|e| e.path.len()).max().unwrap_or(4).max(4);
-    writeln!(out, "{:<width$}  {:>5}  {:>10}  {:>8}  {:<6}  status", "path", "modes", "f1 [Hz]", "seconds", "reused")?;
+    writeln!(
+        out,
+        "{:<width$}  {:>5}  {:>10}  {:>8}  {:<6}  status",
+        "path", "modes", "f1 [Hz]", "seconds", "reused"
+    )?;
     for e in &catalogue.assets {
         let f1 = e.first_frequency_hz.map_or("-".to_string(), |f| format!("{f:.1}"));
         let reused = if e.cached { "yes" } else { "no" };
-        writeln!(out, "{:<width$}  {:>5}  {f1:>10}  {:>8.2}  {reused:<6}  {}", e.path, e.modes, e.seconds, e.status)?;
+        writeln!(
+            out,
+            "{:<width$}  {:>5}  {f1:>10}  {:>8.2}  {reused:<6}  {}",
+            e.path, e.modes, e.seconds, e.status
+        )?;
     }
     Ok(())
 }

@@ -49,7 +49,8 @@ pub fn run(command: CatalogueCommand) -> Result<()> {
 }
 
 fn merge(args: MergeArgs) -> Result<()> {
-    let out_dir = args.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let out_dir =
+        args.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
     std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let (merged, report) = modal_batch::merge(&args.inputs, out_dir)?;
     if !merged.complete && !args.partial {
@@ -60,7 +61,10 @@ fn merge(args: MergeArgs) -> Result<()> {
         if why.is_empty() {
             why.push("an input catalogue is marked incomplete".into());
         }
-        bail!("the catalogues are incomplete ({}); re-run the missing shards, or pass --partial", why.join("; "));
+        bail!(
+            "the catalogues are incomplete ({}); re-run the missing shards, or pass --partial",
+            why.join("; ")
+        );
     }
     report.missing.iter().for_each(|m| warn(&format!("missing {m}")));
     merged.save(&args.out)?;

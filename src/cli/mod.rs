@@ -4,10 +4,10 @@
 
 mod args;
 mod bank_cmds;
-mod batch;
-mod catalogue;
 mod bank_report;
+mod batch;
 mod bench;
+mod catalogue;
 mod interrupt;
 mod material;
 mod mesh;

@@ -209,7 +209,11 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
 fn catalogue_files(input: &Path, missing: &mut Vec<String>) -> Result<Vec<PathBuf>, BatchError> {
     let bad = |message: String| BatchError::Catalogue { path: input.display().to_string(), message };
     if !input.is_dir() {
-        return if input.is_file() { Ok(vec![input.to_path_buf()]) } else { Err(bad("no such file or directory".into())) };
+        return if input.is_file() {
+            Ok(vec![input.to_path_buf()])
+        } else {
+            Err(bad("no such file or directory".into()))
+        };
     }
     let rd = std::fs::read_dir(input)
         .map_err(|source| BatchError::Read { path: input.display().to_string(), source })?;
@@ -237,7 +241,9 @@ fn catalogue_files(input: &Path, missing: &mut Vec<String>) -> Result<Vec<PathBu
     }
     let (count, files) = shards.into_iter().next().expect("one shard count");
     missing.extend(
-        (0..count).filter(|i| !files.contains_key(i)).map(|i| format!("{}: shard {i} of {count}", input.display())),
+        (0..count)
+            .filter(|i| !files.contains_key(i))
+            .map(|i| format!("{}: shard {i} of {count}", input.display())),
     );
     Ok(files.into_values().collect())
 }
@@ -345,7 +351,9 @@ mod tests {
         assert!(merge(&files, dir.path()).unwrap_err().to_string().contains("different results"));
         let mixed = tempfile::tempdir().unwrap();
         for shard in [Shard::new(0, 2).unwrap(), Shard::new(0, 3).unwrap()] {
-            Catalogue::new(vec![], vec![], shard).save(&mixed.path().join(Catalogue::file_name(shard))).unwrap();
+            Catalogue::new(vec![], vec![], shard)
+                .save(&mixed.path().join(Catalogue::file_name(shard)))
+                .unwrap();
         }
         assert!(merge(&[mixed.path().to_path_buf()], mixed.path()).unwrap_err().to_string().contains("2, 3"));
         let empty = tempfile::tempdir().unwrap();
@@ -360,7 +368,7 @@ mod tests {
         Catalogue::new(vec![entry("props/a.obj", "ok", 1.0)], vec!["b.obj".into()], Shard::WHOLE)
             .save(&run.join(CATALOGUE_FILE))
             .unwrap();
-        let (merged, _) = merge(&[run.clone()], root.path()).unwrap();
+        let (merged, _) = merge(std::slice::from_ref(&run), root.path()).unwrap();
         assert_eq!(merged.assets[0].bank.as_deref(), Some("runs/one/props/a.bank"));
         assert_eq!(merged.pending, ["b.obj"]);
         assert!(!merged.complete);

@@ -45,11 +45,9 @@ impl Pattern {
 fn match_segments(pattern: &[String], parts: &[&str]) -> bool {
     match pattern.split_first() {
         None => parts.is_empty(),
-        Some((seg, rest)) if seg == "**" => {
-            (0..=parts.len()).any(|skip| {
-                parts[..skip].iter().all(|p| !p.starts_with('.')) && match_segments(rest, &parts[skip..])
-            })
-        }
+        Some((seg, rest)) if seg == "**" => (0..=parts.len()).any(|skip| {
+            parts[..skip].iter().all(|p| !p.starts_with('.')) && match_segments(rest, &parts[skip..])
+        }),
         Some((seg, rest)) => {
             parts.split_first().is_some_and(|(p, tail)| match_name(seg, p) && match_segments(rest, tail))
         }
@@ -135,7 +133,7 @@ fn walk(
     Ok(())
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Kind {
     File,
     Dir,
@@ -204,7 +202,8 @@ mod tests {
     #[test]
     fn expansion_is_sorted_and_matches_the_matcher() {
         let dir = tempfile::tempdir().unwrap();
-        let files = ["props/b.obj", "props/a.obj", "props/sub/c.obj", "props/sub/d.stl", "props/.h/e.obj", "f.obj"];
+        let files =
+            ["props/b.obj", "props/a.obj", "props/sub/c.obj", "props/sub/d.stl", "props/.h/e.obj", "f.obj"];
         for f in files {
             let path = dir.path().join(f);
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();

@@ -26,7 +26,6 @@ use modal_fem::{Material, MaterialOverrides};
 use modal_precompute::{MeshSource, Request, SurfaceMeshing};
 use serde::Deserialize;
 
-
 use crate::glob::{expand, Pattern};
 use crate::BatchError;
 
@@ -285,7 +284,7 @@ impl Manifest {
         if resolved.damping_defaulted_to_zero {
             warnings.push(format!("{path}: no damping given (alpha/beta): its modes ring forever"));
         }
-        let file = self.base.join(&path);
+        let file = if self.base == Path::new(".") { PathBuf::from(&path) } else { self.base.join(&path) };
         let mut request = Request::new(MeshSource::File(file), resolved.material);
         request.scale = o.scale.unwrap_or(1.0);
         request.order = o.order.unwrap_or(request.order);
@@ -313,7 +312,10 @@ fn check_request(r: &Request, o: &Options) -> Result<(), String> {
         return Err(format!("`min_freq` must be a non-negative number, got {}", r.min_freq_hz));
     }
     if !(r.max_freq_hz.is_finite() && r.max_freq_hz > r.min_freq_hz) {
-        return Err(format!("`max_freq` ({}) must be a finite number above `min_freq` ({})", r.max_freq_hz, r.min_freq_hz));
+        return Err(format!(
+            "`max_freq` ({}) must be a finite number above `min_freq` ({})",
+            r.max_freq_hz, r.min_freq_hz
+        ));
     }
     if o.cell.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
         return Err(format!("`cell` must be a positive length in metres, got {}", o.cell.unwrap_or(0.0)));
@@ -425,9 +427,13 @@ mod tests {
         assert!(err("[[assets]]\npath = \"a.obj\"\nmaterial = \"unobtainium\"").contains("unobtainium"));
         let e = err("[[assets]]\npath = \"a.obj\"\nmaterial = \"steel\"\norder = 3");
         assert!(e.contains("order") && e.contains("#1"), "{e}");
-        assert!(err("[defaults]\nmaterial = \"steel\"\nmin_freq = 100\nmax_freq = 50\n[[assets]]\npath = \"a.obj\"")
-            .contains("max_freq"));
-        let e = err("[defaults]\nmaterial = \"steel\"\n[[assets]]\npath = \"a.obj\"\n[[assets]]\npath = \"a.stl\"");
+        assert!(err(
+            "[defaults]\nmaterial = \"steel\"\nmin_freq = 100\nmax_freq = 50\n[[assets]]\npath = \"a.obj\""
+        )
+        .contains("max_freq"));
+        let e = err(
+            "[defaults]\nmaterial = \"steel\"\n[[assets]]\npath = \"a.obj\"\n[[assets]]\npath = \"a.stl\"",
+        );
         assert!(e.contains("a.bank") && e.contains("#2"), "{e}");
         assert!(err("[defaults]\nmaterial = \"steel\"\n[[assets]]\npath = \"a.obj\"\nbank = \"../x.bank\"")
             .contains("inside the output directory"));
@@ -439,7 +445,8 @@ mod tests {
     #[test]
     fn a_glob_matching_nothing_warns() {
         let dir = tempfile::tempdir().unwrap();
-        let (assets, warnings) = resolve("[[globs]]\npattern = \"*.obj\"\nmaterial = \"steel\"", dir.path()).unwrap();
+        let (assets, warnings) =
+            resolve("[[globs]]\npattern = \"*.obj\"\nmaterial = \"steel\"", dir.path()).unwrap();
         assert!(assets.is_empty());
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("matches no file"));

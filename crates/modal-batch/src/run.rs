@@ -169,7 +169,9 @@ fn solve(
         match ModeBank::load(&out) {
             Ok(bank) if bank.info.input_hash == hash => return Ok((bank, true)),
             Ok(_) => {}
-            Err(e) => warnings.push(format!("{}: replacing the damaged bank {} ({e})", asset.path, out.display())),
+            Err(e) => {
+                warnings.push(format!("{}: replacing the damaged bank {} ({e})", asset.path, out.display()))
+            }
         }
     }
     let outcome = modal_precompute::precompute(request, options.cache.as_ref(), options.force, &mut |_| {})

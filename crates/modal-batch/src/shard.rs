@@ -68,7 +68,8 @@ impl Shard {
 
     /// Parses `I/N` (0-based index, e.g. `0/3`).
     pub fn parse(text: &str) -> Result<Shard, BatchError> {
-        let bad = || BatchError::Shard(format!("--shard must be I/N with 0 <= I < N (e.g. 0/3), got '{text}'"));
+        let bad =
+            || BatchError::Shard(format!("--shard must be I/N with 0 <= I < N (e.g. 0/3), got '{text}'"));
         let (i, n) = text.split_once('/').ok_or_else(bad)?;
         let i: usize = i.trim().parse().map_err(|_| bad())?;
         let n: usize = n.trim().parse().map_err(|_| bad())?;
@@ -118,7 +119,8 @@ impl Shard {
                 Some(n) => n,
                 None => {
                     return Err(BatchError::Shard(
-                        "SLURM_ARRAY_TASK_ID is set but not SLURM_ARRAY_TASK_COUNT: give --shard-count N".into(),
+                        "SLURM_ARRAY_TASK_ID is set but not SLURM_ARRAY_TASK_COUNT: give --shard-count N"
+                            .into(),
                     ))
                 }
             };
@@ -201,9 +203,13 @@ mod tests {
     #[test]
     fn slurm_arrays_are_rebased_to_their_minimum() {
         let vars = [("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_COUNT", "4")];
-        assert_eq!(Shard::select(None, None, env(&vars)).unwrap(), (Shard::new(2, 4).unwrap(), ShardEnv::Slurm));
+        assert_eq!(
+            Shard::select(None, None, env(&vars)).unwrap(),
+            (Shard::new(2, 4).unwrap(), ShardEnv::Slurm)
+        );
         // --array=1-4: ids 1..=4 become shards 0..=3.
-        let vars = [("SLURM_ARRAY_TASK_ID", "4"), ("SLURM_ARRAY_TASK_MIN", "1"), ("SLURM_ARRAY_TASK_COUNT", "4")];
+        let vars =
+            [("SLURM_ARRAY_TASK_ID", "4"), ("SLURM_ARRAY_TASK_MIN", "1"), ("SLURM_ARRAY_TASK_COUNT", "4")];
         assert_eq!(Shard::select(None, None, env(&vars)).unwrap().0, Shard::new(3, 4).unwrap());
         let vars = [("SLURM_ARRAY_TASK_ID", "4"), ("SLURM_ARRAY_TASK_COUNT", "4")];
         assert!(Shard::select(None, None, env(&vars)).is_err(), "id 4 of 4 without MIN is out of range");
@@ -215,7 +221,10 @@ mod tests {
     fn kubernetes_needs_a_count() {
         let vars = [("JOB_COMPLETION_INDEX", "1")];
         assert!(Shard::select(None, None, env(&vars)).is_err());
-        assert_eq!(Shard::select(None, Some(3), env(&vars)).unwrap(), (Shard::new(1, 3).unwrap(), ShardEnv::Kubernetes));
+        assert_eq!(
+            Shard::select(None, Some(3), env(&vars)).unwrap(),
+            (Shard::new(1, 3).unwrap(), ShardEnv::Kubernetes)
+        );
         let vars = [("JOB_COMPLETION_INDEX", "1"), (SHARD_COUNT_ENV, "2")];
         assert_eq!(Shard::select(None, None, env(&vars)).unwrap().0, Shard::new(1, 2).unwrap());
         // The flag's count overrides the variable's.
