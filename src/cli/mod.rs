@@ -8,6 +8,7 @@ mod bank_report;
 mod batch;
 mod bench;
 mod catalogue;
+mod export;
 mod interrupt;
 mod material;
 mod mesh;
@@ -50,7 +51,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Catalogue(command)) => catalogue::run(command),
         Some(Command::Info(args)) => bank_cmds::info(args),
         Some(Command::Retune(args)) => bank_cmds::retune(args),
-        Some(Command::Export(args)) => bank_cmds::export(args),
+        Some(Command::Export(args)) => export::run(args),
         Some(Command::Mesh(args)) => mesh::run(args.shape),
         Some(Command::Strike(args)) => strike::run(args),
         Some(Command::Render(args)) => render::run(args),
