@@ -6,6 +6,7 @@ mod args;
 mod bank_cmds;
 mod bank_report;
 mod bench;
+mod corpus;
 mod interrupt;
 mod material;
 mod mesh;

@@ -40,6 +40,7 @@ mod geom;
 mod lattice;
 mod mesher;
 mod read;
+pub mod corpus;
 pub mod shapes;
 mod stuff;
 mod surface;
