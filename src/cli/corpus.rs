@@ -26,10 +26,15 @@ pub struct CorpusArgs {
 /// Writes the corpus (or one asset of it).
 pub fn run(args: CorpusArgs) -> Result<()> {
     use modal_tetra::corpus::{asset, ASSETS};
-    let selected: Vec<_> = ASSETS.iter().filter(|a| args.name.as_deref().is_none_or(|n| n == a.name)).collect();
+    let selected: Vec<_> =
+        ASSETS.iter().filter(|a| args.name.as_deref().is_none_or(|n| n == a.name)).collect();
     if selected.is_empty() {
         let names: Vec<&str> = ASSETS.iter().map(|a| a.name).collect();
-        bail!("no corpus asset named {:?}; the corpus has: {}", args.name.unwrap_or_default(), names.join(", "));
+        bail!(
+            "no corpus asset named {:?}; the corpus has: {}",
+            args.name.unwrap_or_default(),
+            names.join(", ")
+        );
     }
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut written = Vec::new();
@@ -44,7 +49,12 @@ pub fn run(args: CorpusArgs) -> Result<()> {
         })
         .with_context(|| format!("cannot write {}", path.display()))?;
         if !args.json {
-            println!("wrote {} ({} triangles): {}", path.display(), surface.triangles.len(), info.description);
+            println!(
+                "wrote {} ({} triangles): {}",
+                path.display(),
+                surface.triangles.len(),
+                info.description
+            );
         }
         written.push(serde_json::json!({
             "name": info.name,

@@ -45,15 +45,39 @@ pub struct AssetInfo {
 
 /// The corpus, in a fixed order.
 pub const ASSETS: [AssetInfo; 9] = [
-    AssetInfo { name: "teapot", description: "four intersecting open shells: body, lid, spout, handle", odd: false },
-    AssetInfo { name: "vessel", description: "closed cup with a thin handle and a spout (overlapping parts)", odd: false },
+    AssetInfo {
+        name: "teapot",
+        description: "four intersecting open shells: body, lid, spout, handle",
+        odd: false,
+    },
+    AssetInfo {
+        name: "vessel",
+        description: "closed cup with a thin handle and a spout (overlapping parts)",
+        odd: false,
+    },
     AssetInfo { name: "holed_sphere", description: "sphere with two holes (open boundary)", odd: false },
-    AssetInfo { name: "nonmanifold", description: "two boxes sharing an edge, plus a dangling fin triangle", odd: false },
-    AssetInfo { name: "animal", description: "four-legged animal-like body of overlapping closed parts", odd: false },
-    AssetInfo { name: "bracket", description: "CAD L-bracket with a gusset: sharp edges and corners", odd: false },
+    AssetInfo {
+        name: "nonmanifold",
+        description: "two boxes sharing an edge, plus a dangling fin triangle",
+        odd: false,
+    },
+    AssetInfo {
+        name: "animal",
+        description: "four-legged animal-like body of overlapping closed parts",
+        odd: false,
+    },
+    AssetInfo {
+        name: "bracket",
+        description: "CAD L-bracket with a gusset: sharp edges and corners",
+        odd: false,
+    },
     AssetInfo { name: "thin_shell", description: "bell with a wall 1.2 % of its height", odd: false },
     AssetInfo { name: "sheet", description: "a single flat open square: no volume", odd: true },
-    AssetInfo { name: "soup", description: "box as a triangle soup: duplicate vertices, flipped and zero-area triangles", odd: true },
+    AssetInfo {
+        name: "soup",
+        description: "box as a triangle soup: duplicate vertices, flipped and zero-area triangles",
+        odd: true,
+    },
 ];
 
 /// The asset called `name`, scaled to [`DIAGONAL_M`]; `None` for an unknown name.
@@ -193,7 +217,8 @@ fn vessel() -> TriSurface {
     let profile = [(0.0, 0.0), (r, 0.0), (r, h), (r - wall, h), (r - wall, wall), (0.0, wall)];
     let cup = revolve(&profile, 48, "cup");
     let handle = tube(&arc([-r + 0.002, 0.0, 0.055], 0.032, 0.5 * PI, 1.5 * PI, 20), |_| 0.0035, 10, true);
-    let spout_path: Vec<V3> = (0..=8).map(|k| [r - 0.003 + 0.035 * k as f64 / 8.0, 0.0, 0.08 + 0.02 * k as f64 / 8.0]).collect();
+    let spout_path: Vec<V3> =
+        (0..=8).map(|k| [r - 0.003 + 0.035 * k as f64 / 8.0, 0.0, 0.08 + 0.02 * k as f64 / 8.0]).collect();
     let spout = tube(&spout_path, |i| 0.007 - 0.003 * i as f64 / 8.0, 12, true);
     assemble(vec![(cup, "cup"), (handle, "handle"), (spout, "spout")])
 }
@@ -228,12 +253,15 @@ fn nonmanifold() -> TriSurface {
 /// Torso, four legs, neck, head, ears and tail: overlapping closed parts.
 fn animal() -> TriSurface {
     let mut parts = vec![(ellipsoid([0.0, 0.0, 0.09], [0.08, 0.035, 0.03], 3), "torso")];
-    for (k, (x, y)) in [(0.055, 0.02), (0.055, -0.02), (-0.055, 0.02), (-0.055, -0.02)].into_iter().enumerate() {
+    for (k, (x, y)) in
+        [(0.055, 0.02), (0.055, -0.02), (-0.055, 0.02), (-0.055, -0.02)].into_iter().enumerate()
+    {
         let leg: Vec<V3> = (0..=6).map(|i| [x, y, 0.1 - 0.1 * i as f64 / 6.0]).collect();
         let name = ["leg_fl", "leg_fr", "leg_bl", "leg_br"][k];
         parts.push((tube(&leg, |i| 0.011 - 0.004 * i as f64 / 6.0, 12, true), name));
     }
-    let neck: Vec<V3> = (0..=6).map(|i| [0.07 + 0.03 * i as f64 / 6.0, 0.0, 0.1 + 0.04 * i as f64 / 6.0]).collect();
+    let neck: Vec<V3> =
+        (0..=6).map(|i| [0.07 + 0.03 * i as f64 / 6.0, 0.0, 0.1 + 0.04 * i as f64 / 6.0]).collect();
     parts.push((tube(&neck, |_| 0.014, 12, true), "neck"));
     parts.push((ellipsoid([0.11, 0.0, 0.15], [0.03, 0.018, 0.018], 2), "head"));
     parts.push((ellipsoid([0.1, 0.012, 0.172], [0.006, 0.003, 0.012], 1), "ear_l"));

@@ -33,6 +33,7 @@
 //! [`TetraError::Parse`]; the default panic hook may still print it).
 
 mod bvh;
+pub mod corpus;
 mod diagnose;
 mod error;
 mod features;
@@ -40,7 +41,6 @@ mod geom;
 mod lattice;
 mod mesher;
 mod read;
-pub mod corpus;
 pub mod shapes;
 mod stuff;
 mod surface;
