@@ -210,3 +210,32 @@ fn pressure_scales_with_air_density_and_skips_inaudible_modes() {
         assert_eq!(skipped.contains(&i), bank.frequencies_hz[i as usize] > 1000.0, "mode {i}");
     }
 }
+
+#[test]
+fn stored_far_field_matches_the_solve_and_info_shows_power() {
+    let dir = temp_dir();
+    sphere_bank(dir.path());
+    let far = [0.2, -0.15, 0.1];
+    let p = format!("{},{},{}", far[0], far[1], far[2]);
+    let args = ["radiation", "sphere.bank", "--point", &p, "--mode", "5", "--mode", "10", "--store", "rad.bank", "--json"];
+    let solved = modal(dir.path(), &args).ok().json();
+    let (bank, table) = ModeBank::load_with_radiation(dir.path().join("rad.bank")).unwrap();
+    let table = table.expect("the stored bank has a radiation table");
+    assert_eq!(bank, ModeBank::load(dir.path().join("sphere.bank")).unwrap(), "same modes");
+    assert_eq!(table.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [5, 10]);
+    let info = modal(dir.path(), &["info", "rad.bank", "--json"]).ok().json();
+    for m in solved["modes"].as_array().unwrap() {
+        let i = m["index"].as_u64().unwrap() as usize;
+        let entry = table.mode(i).unwrap();
+        // Stored expansion vs the boundary-element pressure at the point.
+        let mp = modal_radiation::modes::stored_multipole(&table, entry);
+        let z = mp.pressure_at(far);
+        let want = c64::new(m["pressure_pa"][0][0].as_f64().unwrap(), m["pressure_pa"][0][1].as_f64().unwrap());
+        assert!((z - want).norm() < 0.02 * want.norm(), "mode {i}: stored {z} vs solved {want}");
+        assert_eq!(info["modes"][i]["radiated_power_w"].as_f64(), m["radiated_power_w"].as_f64());
+        assert!(info["modes"][i]["radiation_efficiency"].as_f64().unwrap() > 0.0);
+    }
+    assert!(info["modes"][0]["radiated_power_w"].is_null(), "modes not solved stay null");
+    let table_text = modal(dir.path(), &["info", "rad.bank"]).ok().stdout;
+    assert!(table_text.contains("radiated W"), "{table_text}");
+}

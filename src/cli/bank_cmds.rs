@@ -14,7 +14,11 @@ pub fn load_bank(path: &std::path::Path) -> Result<ModeBank> {
 }
 
 fn show(bank: &ModeBank, json: bool) -> Result<()> {
-    let report = BankJson::new(bank, false);
+    show_with(bank, None, json)
+}
+
+fn show_with(bank: &ModeBank, radiation: Option<&modal_bank::RadiationTable>, json: bool) -> Result<()> {
+    let report = BankJson::new(bank, false).with_radiation(radiation);
     if json {
         print_json(&report)
     } else {
@@ -24,7 +28,9 @@ fn show(bank: &ModeBank, json: bool) -> Result<()> {
 }
 
 pub fn info(args: InfoArgs) -> Result<()> {
-    show(&load_bank(&args.bank)?, args.json)
+    let (bank, radiation) = ModeBank::load_with_radiation(&args.bank)
+        .with_context(|| format!("cannot load bank {}", args.bank.display()))?;
+    show_with(&bank, radiation.as_ref(), args.json)
 }
 
 pub fn retune(args: RetuneArgs) -> Result<()> {

@@ -17,6 +17,11 @@ pub struct ModeJson {
     pub residual: f64,
     /// Seconds until the mode decayed by 60 dB (null when undamped).
     pub t60_s: Option<f64>,
+    /// Radiated power at unit modal velocity amplitude [W] (null: not stored
+    /// in the bank; `modal radiation BANK --store OUT` computes it).
+    pub radiated_power_w: Option<f64>,
+    /// Radiation efficiency P / (½ρ₀c∫|v_n|²dS) (null: not stored).
+    pub radiation_efficiency: Option<f64>,
 }
 
 /// Sylvester inertia count: eigenvalues below the check shift.
@@ -72,6 +77,19 @@ impl BankJson {
         }
     }
 
+    /// Fills each mode's radiated power and efficiency from a stored table.
+    pub fn with_radiation(mut self, table: Option<&modal_bank::RadiationTable>) -> Self {
+        if let Some(table) = table {
+            for (i, mode) in self.modes.iter_mut().enumerate() {
+                if let Some(t) = table.mode(i) {
+                    mode.radiated_power_w = Some(t.power_w);
+                    mode.radiation_efficiency = Some(t.efficiency);
+                }
+            }
+        }
+        self
+    }
+
     /// Writes the human-readable table.
     pub fn write_table(&self, out: &mut impl Write) -> std::io::Result<()> {
         let m = &self.material;
@@ -97,14 +115,19 @@ impl BankJson {
             m.alpha,
             m.beta
         )?;
-        writeln!(
+        let radiation = self.modes.iter().any(|m| m.radiated_power_w.is_some());
+        write!(
             out,
             "{:>5}  {:>14}  {:>13}  {:>11}  {:>10}",
             "mode", "frequency Hz", "damping ratio", "T60 s", "residual"
         )?;
+        if radiation {
+            write!(out, "  {:>12}  {:>10}", "radiated W", "rad. eff.")?;
+        }
+        writeln!(out)?;
         for (i, mode) in self.modes.iter().enumerate() {
             let t60 = mode.t60_s.map_or("inf".to_string(), |t| format!("{t:.4}"));
-            writeln!(
+            write!(
                 out,
                 "{:>5}  {:>14.3}  {:>13.3e}  {:>11}  {:>10.2e}",
                 i + 1,
@@ -113,6 +136,12 @@ impl BankJson {
                 t60,
                 mode.residual
             )?;
+            if radiation {
+                let p = mode.radiated_power_w.map_or("-".to_string(), |p| format!("{p:.3e}"));
+                let e = mode.radiation_efficiency.map_or("-".to_string(), |e| format!("{e:.3e}"));
+                write!(out, "  {p:>12}  {e:>10}")?;
+            }
+            writeln!(out)?;
         }
         let t = &self.timings_s;
         writeln!(
@@ -138,5 +167,7 @@ fn mode_json(bank: &ModeBank, i: usize) -> ModeJson {
         decay_rate,
         residual: bank.residuals[i],
         t60_s: (decay_rate > 0.0).then(|| 1000f64.ln() / decay_rate),
+        radiated_power_w: None,
+        radiation_efficiency: None,
     }
 }

@@ -34,6 +34,10 @@ pub struct RadiationArgs {
     /// Only these modes (indices into the bank; repeatable); default: every audible mode.
     #[arg(long, value_name = "I")]
     pub mode: Vec<usize>,
+    /// Also write a copy of the bank with every solved mode's far-field
+    /// representation stored in it (format version 2), for `info`, `strike`.
+    #[arg(long, value_name = "OUT.bank")]
+    pub store: Option<PathBuf>,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -128,6 +132,16 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         });
     }
     out.sort_by_key(|m| m.index);
+    if let Some(path) = &args.store {
+        match modal_radiation::modes::to_table(&results, &opts) {
+            Some(table) => {
+                super::interrupt::guarded(|| bank.save_with_radiation(path, &table))
+                    .with_context(|| format!("cannot write bank {}", path.display()))?;
+                eprintln!("radiation: stored {} mode(s) in {}", table.modes.len(), path.display());
+            }
+            None => anyhow::bail!("no audible mode to store in {}", path.display()),
+        }
+    }
     let seconds = started.elapsed().as_secs_f64();
     eprintln!("radiation: done in {seconds:.2} s");
     let report = RadiationJson {

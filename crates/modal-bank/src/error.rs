@@ -50,11 +50,11 @@ pub enum BankError {
         found: Option<String>,
     },
     /// A mode bank of a format version this build cannot read.
-    #[error("unsupported bank format version {found:?} (this build reads version {supported})")]
+    #[error("unsupported bank format version {found:?} (this build reads versions 1 to {supported})")]
     UnsupportedVersion {
         /// The `format_version` metadata value found.
         found: String,
-        /// The version this build reads and writes.
+        /// The newest version this build reads (and the one it writes).
         supported: u32,
     },
     /// The stored checksum does not match the file contents.

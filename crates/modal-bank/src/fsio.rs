@@ -59,6 +59,22 @@ impl ModeBank {
         atomic_write(path.as_ref(), |w| w.write_all(&bytes))
     }
 
+    /// Validates and writes the bank with its radiation table to `path`
+    /// atomically (see [`ModeBank::save`]).
+    pub fn save_with_radiation(&self, path: impl AsRef<Path>, table: &crate::RadiationTable) -> Result<(), BankError> {
+        let bytes = self.to_bytes_with_radiation(table)?;
+        atomic_write(path.as_ref(), |w| w.write_all(&bytes))
+    }
+
+    /// Reads the bank at `path` and its radiation table, if it has one.
+    pub fn load_with_radiation(
+        path: impl AsRef<Path>,
+    ) -> Result<(ModeBank, Option<crate::RadiationTable>), BankError> {
+        let path = path.as_ref();
+        let bytes = read_whole(&mut open_regular(path)?, path)?;
+        ModeBank::from_bytes_with_radiation(&bytes)
+    }
+
     /// Reads, verifies (format, version, checksum, shapes) and validates the
     /// bank at `path`. Content errors do not repeat the path; I/O errors do.
     pub fn load(path: impl AsRef<Path>) -> Result<ModeBank, BankError> {

@@ -9,6 +9,8 @@
 //! - [`ModeBank::save`] / [`ModeBank::load`] / [`ModeBank::to_bytes`] /
 //!   [`ModeBank::from_bytes`]: the file format, checksum verified on every load;
 //! - [`ModeBank::validate`]: every invariant of a bank;
+//! - [`RadiationTable`]: optional per-mode acoustic transfer (multipole
+//!   coefficients) stored with the bank ([`ModeBank::save_with_radiation`]);
 //! - [`BankCache`] and [`CacheKey`]: content-addressed storage of banks;
 //! - [`retune`]: new material (same ν) and/or size by exact scaling;
 //! - [`export_vtu`] / [`export_vtu_file`]: surface + mode shapes for ParaView;
@@ -25,6 +27,7 @@ mod error;
 mod format;
 mod fsio;
 mod key;
+mod radiation;
 mod retune;
 mod types;
 mod validate;
@@ -38,5 +41,6 @@ pub use vtu::{export_vtu, export_vtu_file, mode_array_name};
 pub use damping::rayleigh;
 pub use deferred::DeferredBank;
 pub use error::BankError;
-pub use format::{FORMAT_NAME, FORMAT_VERSION};
+pub use format::{FORMAT_NAME, FORMAT_VERSION, OLDEST_READABLE_VERSION};
+pub use radiation::{ModeTransfer, RadiationTable};
 pub use types::*;

@@ -125,7 +125,7 @@ fn writer_is_deterministic_and_checksum_matches_spec() {
     let meta = header.metadata().clone().unwrap();
     assert_eq!(meta["checksum"], spec_checksum(&a));
     assert_eq!(meta["format"], "modal-bank");
-    assert_eq!(meta["format_version"], "1");
+    assert_eq!(meta["format_version"], "2");
     assert_eq!(meta["input_hash"], bank.info.input_hash);
     // Every tensor starts aligned to its element size (zero-copy readers).
     for (name, t) in SafeTensors::deserialize(&a).unwrap().tensors() {
@@ -263,11 +263,68 @@ fn plain_safetensors_file_is_not_a_bank() {
 #[test]
 fn other_format_version_names_the_supported_one() {
     let bytes = rewrite(&linear_bank(2).to_bytes().unwrap(), |_, meta| {
-        meta.insert("format_version".into(), "2".into());
+        meta.insert("format_version".into(), "3".into());
     });
     let err = ModeBank::from_bytes(&bytes).unwrap_err();
-    assert!(matches!(err, BankError::UnsupportedVersion { supported: 1, .. }), "{err}");
-    assert_eq!(err.to_string(), "unsupported bank format version \"2\" (this build reads version 1)");
+    assert!(matches!(err, BankError::UnsupportedVersion { supported: 2, .. }), "{err}");
+    assert_eq!(err.to_string(), "unsupported bank format version \"3\" (this build reads versions 1 to 2)");
+}
+
+#[test]
+fn version_1_banks_still_load_without_radiation() {
+    let bank = linear_bank(2);
+    let bytes = rewrite(&bank.to_bytes().unwrap(), |_, meta| {
+        meta.insert("format_version".into(), "1".into());
+    });
+    let (loaded, table) = ModeBank::from_bytes_with_radiation(&bytes).unwrap();
+    assert_bit_identical(&bank, &loaded);
+    assert!(table.is_none());
+}
+
+fn radiation_table(bank: &ModeBank) -> modal_bank::RadiationTable {
+    let modes = (0..bank.mode_count())
+        .map(|i| modal_bank::ModeTransfer {
+            mode: i,
+            wavenumber: 2.0 + i as f64,
+            order: i,
+            coefficients: (0..(i + 1) * (i + 1)).map(|j| [j as f64 * 0.5, -(j as f64) / 3.0]).collect(),
+            power_w: 1e-3 / (1.0 + i as f64),
+            efficiency: 0.1 * i as f64,
+        })
+        .collect();
+    modal_bank::RadiationTable {
+        centre_m: [0.01, -0.02, 0.3],
+        fit_radius_m: 0.4,
+        air_density_kg_m3: 1.21,
+        sound_speed_m_s: 343.0,
+        tolerance: 0.01,
+        modes,
+    }
+}
+
+#[test]
+fn radiation_table_round_trips_bit_identical_under_the_checksum() {
+    let bank = linear_bank(3);
+    let table = radiation_table(&bank);
+    let bytes = bank.to_bytes_with_radiation(&table).unwrap();
+    let (loaded, got) = ModeBank::from_bytes_with_radiation(&bytes).unwrap();
+    assert_bit_identical(&bank, &loaded);
+    assert_eq!(got.as_ref(), Some(&table));
+    assert_eq!(got.unwrap().mode(2).unwrap().coefficients.len(), 9);
+    // Plain readers see the same bank; the spec checksum covers the new tensors.
+    assert_bit_identical(&bank, &ModeBank::from_bytes(&bytes).unwrap());
+    assert_eq!(spec_checksum(&bytes), SafeTensors::read_metadata(&bytes).unwrap().1.metadata().as_ref().unwrap()["checksum"]);
+    let mut flipped = bytes.clone();
+    let n = flipped.len();
+    flipped[n - 3] ^= 0x10; // inside radiation_coefficients or another tensor: caught
+    assert!(ModeBank::from_bytes_with_radiation(&flipped).is_err());
+    // A table naming a mode the bank lacks is refused when writing.
+    let mut bad = table.clone();
+    bad.modes[0].mode = 99;
+    assert!(bank.to_bytes_with_radiation(&bad).is_err());
+    let mut bad = table;
+    bad.modes[1].coefficients.pop();
+    assert!(bank.to_bytes_with_radiation(&bad).is_err());
 }
 
 #[test]

@@ -305,3 +305,40 @@ pub fn radiate_modes_on(
     }
     Ok(out)
 }
+
+/// The bank-storable table of `results` (see `modal_bank::RadiationTable`),
+/// entries in ascending mode order.
+pub fn to_table(results: &[ModeRadiation], opts: &RadiationOptions) -> Option<modal_bank::RadiationTable> {
+    let first = results.first()?;
+    let mut modes: Vec<modal_bank::ModeTransfer> = results
+        .iter()
+        .map(|r| modal_bank::ModeTransfer {
+            mode: r.mode,
+            wavenumber: r.multipole.wavenumber,
+            order: r.multipole.order,
+            coefficients: r.multipole.coefficients.iter().map(|c| [c.re, c.im]).collect(),
+            power_w: r.power_w,
+            efficiency: r.efficiency,
+        })
+        .collect();
+    modes.sort_by_key(|m| m.mode);
+    Some(modal_bank::RadiationTable {
+        centre_m: first.multipole.centre,
+        fit_radius_m: first.multipole.fit_radius,
+        air_density_kg_m3: opts.air.density_kg_m3,
+        sound_speed_m_s: opts.air.sound_speed_m_s,
+        tolerance: opts.multipole_tolerance,
+        modes,
+    })
+}
+
+/// The multipole expansion of a stored entry.
+pub fn stored_multipole(table: &modal_bank::RadiationTable, entry: &modal_bank::ModeTransfer) -> Multipole {
+    Multipole {
+        centre: table.centre_m,
+        wavenumber: entry.wavenumber,
+        fit_radius: table.fit_radius_m,
+        order: entry.order,
+        coefficients: entry.coefficients.iter().map(|c| c64::new(c[0], c[1])).collect(),
+    }
+}

@@ -81,7 +81,7 @@ fn check_format(meta: Option<&HashMap<String, String>>) -> Result<&HashMap<Strin
         other => return Err(BankError::WrongFormat { found: other.cloned() }),
     }
     match meta.get(KEY_VERSION) {
-        Some(v) if *v == FORMAT_VERSION.to_string() => Ok(meta),
+        Some(v) if (OLDEST_READABLE_VERSION..=FORMAT_VERSION).any(|n| *v == n.to_string()) => Ok(meta),
         Some(v) => Err(BankError::UnsupportedVersion { found: v.clone(), supported: FORMAT_VERSION }),
         None => Err(BankError::MissingMetadata(KEY_VERSION.into())),
     }

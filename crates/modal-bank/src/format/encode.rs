@@ -120,9 +120,25 @@ fn frame(mut tensors: Vec<Tensor>, metadata: BTreeMap<String, String>) -> Result
 }
 
 pub(super) fn to_bytes(bank: &ModeBank) -> Result<Vec<u8>, BankError> {
+    to_bytes_with_radiation(bank, None)
+}
+
+/// [`to_bytes`] plus an optional radiation table (tensors and metadata
+/// key `radiation`, covered by the checksum).
+pub(super) fn to_bytes_with_radiation(
+    bank: &ModeBank,
+    radiation: Option<&crate::RadiationTable>,
+) -> Result<Vec<u8>, BankError> {
     bank.validate()?;
-    let tensors = tensors(bank)?;
+    let mut tensors = tensors(bank)?;
     let mut metadata = metadata(bank)?;
+    if let Some(table) = radiation {
+        table.validate(bank.mode_count())?;
+        for (name, dtype, shape, data) in super::radiation_io::tensors(table) {
+            tensors.push(Tensor { name, dtype, shape, data });
+        }
+        metadata.insert(super::radiation_io::KEY_RADIATION.into(), super::radiation_io::metadata(table)?);
+    }
     let sum = checksum(
         tensors.iter().map(Tensor::view).collect(),
         metadata.iter().map(|(k, v)| (k.as_str(), v.as_str())),

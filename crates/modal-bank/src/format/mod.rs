@@ -7,13 +7,18 @@
 
 mod decode;
 mod encode;
+mod radiation_io;
 
 use crate::{BankError, ModeBank};
 
 /// Value of the metadata key `format`.
 pub const FORMAT_NAME: &str = "modal-bank";
-/// The format version this build writes and reads (metadata `format_version`).
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this build writes (metadata `format_version`). It
+/// reads every version from [`OLDEST_READABLE_VERSION`] to this one.
+/// Version 2 added the optional radiation tensors (`crate::RadiationTable`).
+pub const FORMAT_VERSION: u32 = 2;
+/// The oldest format version this build still reads.
+pub const OLDEST_READABLE_VERSION: u32 = 1;
 
 pub(crate) const KEY_FORMAT: &str = "format";
 pub(crate) const KEY_VERSION: &str = "format_version";
@@ -82,5 +87,21 @@ impl ModeBank {
     /// hostile bytes.
     pub fn from_bytes(bytes: &[u8]) -> Result<ModeBank, BankError> {
         decode::from_bytes(bytes)
+    }
+
+    /// [`ModeBank::to_bytes`] with the per-mode radiation table stored
+    /// alongside (validated against the bank first).
+    pub fn to_bytes_with_radiation(&self, table: &crate::RadiationTable) -> Result<Vec<u8>, BankError> {
+        encode::to_bytes_with_radiation(self, Some(table))
+    }
+
+    /// Decodes a bank file held in memory and its radiation table, if it
+    /// has one (`None` for version-1 banks and banks saved without one).
+    pub fn from_bytes_with_radiation(
+        bytes: &[u8],
+    ) -> Result<(ModeBank, Option<crate::RadiationTable>), BankError> {
+        let bank = decode::from_bytes(bytes)?;
+        let table = radiation_io::read(bytes, bank.mode_count())?;
+        Ok((bank, table))
     }
 }
