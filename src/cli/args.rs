@@ -311,9 +311,17 @@ pub struct StrikeArgs {
     /// Hertz contact of a sphere of MASS_KG and RADIUS_M striking at 1 m/s.
     #[arg(long, value_name = "MASS_KG,RADIUS_M", value_parser = parse_pair, allow_hyphen_values = true)]
     pub hertz: Option<[f64; 2]>,
-    /// Contact microphone position X,Y,Z [m] (default: the first struck point).
+    /// Contact microphone position X,Y,Z [m]: output the normal surface velocity there [m/s, full scale 1]
+    /// instead of the pressure at a listener.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub mic: Option<[f64; 3]>,
+    /// Listener position X,Y,Z [m] in the bank's frame: output the pressure there (full scale 20 Pa).
+    /// Default: 0.5 m from the first struck point along its outward normal.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, conflicts_with = "mic")]
+    pub listener: Option<[f64; 3]>,
+    /// Solve the radiation now when the bank has none stored (slow; see `modal radiation --store`).
+    #[arg(long, conflicts_with = "mic")]
+    pub solve_radiation: bool,
     /// Duration [s] (default: until the sound decayed by 60 dB).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub duration: Option<f64>,

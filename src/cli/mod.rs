@@ -11,6 +11,7 @@ mod catalogue;
 mod corpus;
 mod export;
 mod interrupt;
+mod listener;
 mod material;
 mod mesh;
 mod output;

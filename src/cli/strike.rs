@@ -1,4 +1,6 @@
-//! `modal strike`: strike a bank at surface points and write the sound.
+//! `modal strike`: strike a bank at surface points and write the sound: the
+//! pressure at a listener (default 0.5 m off the first struck point, see
+//! [`super::listener`]) or, with `--mic`, a contact microphone.
 
 use anyhow::{bail, ensure, Context, Result};
 use modal_bank::ModeBank;
@@ -11,6 +13,7 @@ use serde::Serialize;
 use super::args::StrikeArgs;
 use super::bank_cmds::load_bank;
 use super::interrupt;
+use super::listener::{listener_gains, TransferSource, DEFAULT_LISTENER_DISTANCE_M};
 use super::output::{print_json, warn};
 
 /// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
@@ -22,9 +25,18 @@ const NORMALIZED_PEAK: f64 = 0.891;
 /// Approach speed [m/s] assumed by `--hertz` (t_c ∝ v^{−1/5}, so it matters little).
 const HERTZ_SPEED_M_S: f64 = 1.0;
 
+/// What the samples are: `listener` pressure / 20 Pa, or `contact_mic` velocity / (1 m/s).
+#[derive(Serialize)]
+struct OutputJson {
+    kind: &'static str,
+    listener_m: Option<[f64; 3]>,
+    transfer: Option<TransferSource>,
+}
+
 #[derive(Serialize)]
 struct StrikeJson {
     out: String,
+    output: OutputJson,
     sample_rate: u32,
     duration_s: f64,
     capped: bool,
@@ -109,11 +121,23 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             time_s,
         });
     }
-    let options = SynthOptions {
-        sample_rate: args.rate as f64,
-        gain: OutputGain::ContactMic { at: args.mic },
-        ..SynthOptions::default()
+    // Output: the pressure at a listener (default), or a contact microphone.
+    let (gain, output) = match args.mic {
+        Some(at) => (OutputGain::ContactMic { at: Some(at) }, OutputJson { kind: "contact_mic", listener_m: None, transfer: None }),
+        None => {
+            let listener = args.listener.unwrap_or_else(|| {
+                let p = &points_json[0];
+                let n = model.locate(p.surface_point).map(|h| h.normal).unwrap_or([0.0, 0.0, 1.0]);
+                [0, 1, 2].map(|c| p.surface_point[c] + DEFAULT_LISTENER_DISTANCE_M * n[c])
+            });
+            let heard = listener_gains(&args.bank, &bank, listener, args.solve_radiation)?;
+            (
+                OutputGain::PerMode(heard.gains),
+                OutputJson { kind: "listener", listener_m: Some(listener), transfer: Some(heard.source) },
+            )
+        }
     };
+    let options = SynthOptions { sample_rate: args.rate as f64, gain, ..SynthOptions::default() };
     let length = match args.duration {
         Some(d) => RenderLength::Fixed(d),
         None => RenderLength::Auto { cap_s: AUTO_DURATION_CAP_S },
@@ -138,6 +162,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     }
     let json = StrikeJson {
         out: args.out.display().to_string(),
+        output,
         sample_rate: args.rate,
         duration_s: rendered.duration_s,
         capped: rendered.capped,
@@ -190,6 +215,13 @@ fn print_human(json: &StrikeJson) {
             s.impulse_ns[1],
             s.impulse_ns[2]
         );
+    }
+    match (&json.output.listener_m, json.output.transfer) {
+        (Some(l), Some(t)) => println!(
+            "output: pressure at the listener ({:.4}, {:.4}, {:.4}) m, full scale 20 Pa (transfer: {t:?})",
+            l[0], l[1], l[2]
+        ),
+        _ => println!("output: contact microphone, normal surface velocity, full scale 1 m/s"),
     }
     println!("contact time {:.3e} s; loudest modes excited by the first strike:", json.contact_time_s);
     for m in &json.top_modes {

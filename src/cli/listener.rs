@@ -1,0 +1,125 @@
+//! What `strike` hears at a listener: per-mode pressure transfer gains.
+//!
+//! Mode `i` moving with modal velocity `q̇_i(t)` radiates `p(x, t) ≈
+//! |T_i(x)| q̇_i(t)` at the listener, `T_i(x)` the complex pressure [Pa] for
+//! unit modal velocity amplitude (`modal radiation`). The synthesizer's
+//! per-mode gains are real, so each mode keeps its level and decay; the
+//! phase of `T_i` (a per-mode time offset of a fraction of a period, plus
+//! the common propagation delay `r/c`) is dropped. Samples are pressure
+//! divided by [`FULL_SCALE_PA`], the full scale of `render` at gain 1.
+//!
+//! The transfer comes from, in order of preference:
+//! 1. the bank's stored radiation table (`modal radiation --store`),
+//! 2. a boundary-element solve now (`--solve-radiation`),
+//! 3. the level estimate `render` uses without radiation (a pulsating
+//!    sphere with the object's area and the mode's RMS normal velocity,
+//!    `ρ₀c (a/r) (ka/√(1+(ka)²)) v_i`), with a warning.
+
+use std::path::Path;
+
+use anyhow::{ensure, Context, Result};
+use modal_bank::ModeBank;
+use modal_radiation::{Air, RadiationOptions};
+use modal_scene::{AIR_IMPEDANCE_PA_S_M, FULL_SCALE_PA, MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
+use modal_synth::SynthModel;
+
+use super::output::warn;
+
+/// Default listener distance from the first struck point, along its outward normal [m].
+pub const DEFAULT_LISTENER_DISTANCE_M: f64 = 0.5;
+
+/// Where the per-mode transfer came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TransferSource {
+    /// The bank's stored multipole expansions.
+    Stored,
+    /// A boundary-element solve in this run.
+    Solved,
+    /// The pulsating-sphere level estimate (no radiation data).
+    Estimate,
+}
+
+/// Per-mode output gains (sample units per unit modal velocity) at a listener.
+pub struct ListenerGains {
+    /// One gain per bank mode: `|T_i| / FULL_SCALE_PA`.
+    pub gains: Vec<f64>,
+    /// Where the transfer came from.
+    pub source: TransferSource,
+}
+
+/// Gains for a listener at `x` (bank frame) of the bank stored at `path`.
+pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) -> Result<ListenerGains> {
+    let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
+    ensure!(!mesh.contains(x), "listener {},{},{} lies inside the body: pressure is only defined outside it", x[0], x[1], x[2]);
+    let audible: Vec<usize> =
+        (0..bank.mode_count()).filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ).collect();
+    let (_, table) =
+        ModeBank::load_with_radiation(path).with_context(|| format!("cannot load bank {}", path.display()))?;
+    if let Some(table) = table.filter(|_| !solve) {
+        let estimate = estimate_gains(bank, x)?;
+        let mut gains = vec![0.0; bank.mode_count()];
+        let mut missing = 0;
+        let r = distance(x, table.centre_m);
+        if r < table.fit_radius_m {
+            warn(&format!(
+                "the listener is {r:.3} m from the centre of mass, inside the {:.3} m radius the stored far field is accurate beyond",
+                table.fit_radius_m
+            ));
+        }
+        for &i in &audible {
+            match table.mode(i) {
+                Some(entry) => {
+                    let mp = modal_radiation::modes::stored_multipole(&table, entry);
+                    gains[i] = mp.pressure_at(x).norm() / FULL_SCALE_PA;
+                }
+                None => {
+                    gains[i] = estimate[i];
+                    missing += 1;
+                }
+            }
+        }
+        if missing > 0 {
+            warn(&format!("{missing} audible mode(s) have no stored radiation: their level is estimated"));
+        }
+        return Ok(ListenerGains { gains, source: TransferSource::Stored });
+    }
+    if solve {
+        let opts = RadiationOptions { air: Air::default(), ..RadiationOptions::default() };
+        let started = std::time::Instant::now();
+        let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &audible, &opts, &mut |p| eprintln!("{p}"))?;
+        eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
+        let mut gains = vec![0.0; bank.mode_count()];
+        for r in &results {
+            gains[r.mode] = r.surface.pressure_at(&mesh, x)?.norm() / FULL_SCALE_PA;
+        }
+        return Ok(ListenerGains { gains, source: TransferSource::Solved });
+    }
+    warn(&format!(
+        "{} has no radiation data: the listener level is a pulsating-sphere estimate \
+         (run `modal radiation BANK --store OUT.bank`, or strike with --solve-radiation)",
+        path.display()
+    ));
+    Ok(ListenerGains { gains: estimate_gains(bank, x)?, source: TransferSource::Estimate })
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// `render`'s level estimate per mode at `x`, in sample units.
+fn estimate_gains(bank: &ModeBank, x: [f64; 3]) -> Result<Vec<f64>> {
+    let model = SynthModel::new(bank).context("cannot synthesize this bank")?;
+    let area: f64 = modal_radiation::modes::boundary_mesh(bank)?.area();
+    let a = (area / (4.0 * std::f64::consts::PI)).sqrt();
+    let r = distance(x, bank.mass.center_of_mass_m).max(MIN_DISTANCE_M);
+    Ok(model
+        .rms_normal_shapes()
+        .iter()
+        .zip(&bank.frequencies_hz)
+        .map(|(v, f)| {
+            let ka = 2.0 * std::f64::consts::PI * f / SPEED_OF_SOUND_M_S * a;
+            AIR_IMPEDANCE_PA_S_M * (a / r) * ka / (1.0 + ka * ka).sqrt() * v / FULL_SCALE_PA
+        })
+        .collect())
+}
