@@ -217,7 +217,19 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     sphere_bank(dir.path());
     let far = [0.2, -0.15, 0.1];
     let p = format!("{},{},{}", far[0], far[1], far[2]);
-    let args = ["radiation", "sphere.bank", "--point", &p, "--mode", "5", "--mode", "10", "--store", "rad.bank", "--json"];
+    let args = [
+        "radiation",
+        "sphere.bank",
+        "--point",
+        &p,
+        "--mode",
+        "5",
+        "--mode",
+        "10",
+        "--store",
+        "rad.bank",
+        "--json",
+    ];
     let solved = modal(dir.path(), &args).ok().json();
     let (bank, table) = ModeBank::load_with_radiation(dir.path().join("rad.bank")).unwrap();
     let table = table.expect("the stored bank has a radiation table");
@@ -230,7 +242,8 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
         // Stored expansion vs the boundary-element pressure at the point.
         let mp = modal_radiation::modes::stored_multipole(&table, entry);
         let z = mp.pressure_at(far);
-        let want = c64::new(m["pressure_pa"][0][0].as_f64().unwrap(), m["pressure_pa"][0][1].as_f64().unwrap());
+        let want =
+            c64::new(m["pressure_pa"][0][0].as_f64().unwrap(), m["pressure_pa"][0][1].as_f64().unwrap());
         assert!((z - want).norm() < 0.02 * want.norm(), "mode {i}: stored {z} vs solved {want}");
         assert_eq!(info["modes"][i]["radiated_power_w"].as_f64(), m["radiated_power_w"].as_f64());
         assert!(info["modes"][i]["radiation_efficiency"].as_f64().unwrap() > 0.0);
@@ -238,4 +251,47 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert!(info["modes"][0]["radiated_power_w"].is_null(), "modes not solved stay null");
     let table_text = modal(dir.path(), &["info", "rad.bank"]).ok().stdout;
     assert!(table_text.contains("radiated W"), "{table_text}");
+}
+
+#[test]
+fn strike_hears_the_listener_by_default_linearly_and_audibly() {
+    let dir = temp_dir();
+    sphere_bank(dir.path());
+    modal(dir.path(), &["radiation", "sphere.bank", "--store", "rad.bank"]).ok();
+    let strike = |bank: &str, extra: &[&str], out: &str| {
+        let mut a =
+            vec!["strike", bank, "--at", "0.05,0,0", "--duration", "0.2", "--float", "-o", out, "--json"];
+        a.extend(extra);
+        modal(dir.path(), &a).ok()
+    };
+    let one = strike("rad.bank", &[], "one.wav").json();
+    assert_eq!(one["output"]["kind"], "listener");
+    assert_eq!(one["output"]["transfer"], "stored");
+    // Default listener: 0.5 m off the struck point along its normal.
+    let l: Vec<f64> =
+        one["output"]["listener_m"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let s: Vec<f64> =
+        one["strikes"][0]["surface_point"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let d = ((l[0] - s[0]).powi(2) + (l[1] - s[1]).powi(2) + (l[2] - s[2]).powi(2)).sqrt();
+    assert!((d - 0.5).abs() < 1e-9, "listener {d} m from the struck point");
+    let peak = one["peak"].as_f64().unwrap();
+    assert!(peak > 1e-2, "audible without --normalize: peak {peak} of full scale");
+    let two = strike("rad.bank", &["--impulse", "0.02"], "two.wav").json();
+    assert!((two["peak"].as_f64().unwrap() / peak - 2.0).abs() < 1e-6, "linear in the impulse");
+    // Without stored radiation: the estimate, with a warning; or a solve on request, equal to the stored one.
+    let est = strike("sphere.bank", &[], "est.wav");
+    assert!(est.stderr.contains("no radiation data"), "{}", est.stderr);
+    assert_eq!(est.json()["output"]["transfer"], "estimate");
+    let solved = strike("sphere.bank", &["--solve-radiation"], "solved.wav").json();
+    assert_eq!(solved["output"]["transfer"], "solved");
+    assert!(
+        (solved["peak"].as_f64().unwrap() / peak - 1.0).abs() < 0.02,
+        "solved {} vs stored {peak}",
+        solved["peak"]
+    );
+    // The contact microphone stays available; a listener inside the body is an error.
+    assert_eq!(strike("rad.bank", &["--mic", "0.05,0,0"], "mic.wav").json()["output"]["kind"], "contact_mic");
+    modal(dir.path(), &["strike", "rad.bank", "--at", "0.05,0,0", "--listener", "0,0,0.01", "-o", "x.wav"])
+        .fails_with("inside the body");
+    assert!(!dir.path().join("x.wav").exists());
 }

@@ -51,11 +51,18 @@ pub struct ListenerGains {
 /// Gains for a listener at `x` (bank frame) of the bank stored at `path`.
 pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) -> Result<ListenerGains> {
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
-    ensure!(!mesh.contains(x), "listener {},{},{} lies inside the body: pressure is only defined outside it", x[0], x[1], x[2]);
-    let audible: Vec<usize> =
-        (0..bank.mode_count()).filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ).collect();
-    let (_, table) =
-        ModeBank::load_with_radiation(path).with_context(|| format!("cannot load bank {}", path.display()))?;
+    ensure!(
+        !mesh.contains(x),
+        "listener {},{},{} lies inside the body: pressure is only defined outside it",
+        x[0],
+        x[1],
+        x[2]
+    );
+    let audible: Vec<usize> = (0..bank.mode_count())
+        .filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ)
+        .collect();
+    let (_, table) = ModeBank::load_with_radiation(path)
+        .with_context(|| format!("cannot load bank {}", path.display()))?;
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
         let mut gains = vec![0.0; bank.mode_count()];
@@ -87,7 +94,9 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
     if solve {
         let opts = RadiationOptions { air: Air::default(), ..RadiationOptions::default() };
         let started = std::time::Instant::now();
-        let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &audible, &opts, &mut |p| eprintln!("{p}"))?;
+        let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &audible, &opts, &mut |p| {
+            eprintln!("{p}")
+        })?;
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
         let mut gains = vec![0.0; bank.mode_count()];
         for r in &results {

@@ -123,7 +123,10 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     }
     // Output: the pressure at a listener (default), or a contact microphone.
     let (gain, output) = match args.mic {
-        Some(at) => (OutputGain::ContactMic { at: Some(at) }, OutputJson { kind: "contact_mic", listener_m: None, transfer: None }),
+        Some(at) => (
+            OutputGain::ContactMic { at: Some(at) },
+            OutputJson { kind: "contact_mic", listener_m: None, transfer: None },
+        ),
         None => {
             let listener = args.listener.unwrap_or_else(|| {
                 let p = &points_json[0];

@@ -61,7 +61,11 @@ impl ModeBank {
 
     /// Validates and writes the bank with its radiation table to `path`
     /// atomically (see [`ModeBank::save`]).
-    pub fn save_with_radiation(&self, path: impl AsRef<Path>, table: &crate::RadiationTable) -> Result<(), BankError> {
+    pub fn save_with_radiation(
+        &self,
+        path: impl AsRef<Path>,
+        table: &crate::RadiationTable,
+    ) -> Result<(), BankError> {
         let bytes = self.to_bytes_with_radiation(table)?;
         atomic_write(path.as_ref(), |w| w.write_all(&bytes))
     }

@@ -60,7 +60,9 @@ impl RadiationTable {
     /// ascending and unique, modes in range, `(L+1)²` coefficients, finite
     /// values, positive wavenumbers, air and radius.
     pub fn validate(&self, mode_count: usize) -> Result<(), BankError> {
-        let bad = |field: String, value: f64, rule: &str| Err(BankError::OutOfRange { field, value, rule: rule.into() });
+        let bad = |field: String, value: f64, rule: &str| {
+            Err(BankError::OutOfRange { field, value, rule: rule.into() })
+        };
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !self.centre_m.iter().all(|c| c.is_finite()) {
             return bad("radiation.centre_m".into(), f64::NAN, "must be finite");
@@ -85,7 +87,11 @@ impl RadiationTable {
             }
             last = Some(m.mode);
             if !positive(m.wavenumber) {
-                return bad(format!("radiation_wavenumbers[{i}]"), m.wavenumber, "must be finite and positive");
+                return bad(
+                    format!("radiation_wavenumbers[{i}]"),
+                    m.wavenumber,
+                    "must be finite and positive",
+                );
             }
             if m.coefficients.len() != (m.order + 1) * (m.order + 1) {
                 return bad(format!("radiation_orders[{i}]"), m.order as f64, "needs (L+1)² coefficients");
@@ -93,8 +99,13 @@ impl RadiationTable {
             if m.coefficients.iter().flatten().any(|c| !c.is_finite()) {
                 return bad(format!("radiation_coefficients of mode {}", m.mode), f64::NAN, "must be finite");
             }
-            if !(m.power_w.is_finite() && m.power_w >= 0.0) || !(m.efficiency.is_finite() && m.efficiency >= 0.0) {
-                return bad(format!("radiation_power_w[{i}]"), m.power_w, "power and efficiency must be finite, ≥ 0");
+            let non_negative = |v: f64| v.is_finite() && v >= 0.0;
+            if !non_negative(m.power_w) || !non_negative(m.efficiency) {
+                return bad(
+                    format!("radiation_power_w[{i}]"),
+                    m.power_w,
+                    "power and efficiency must be finite, ≥ 0",
+                );
             }
         }
         Ok(())

@@ -313,7 +313,10 @@ fn radiation_table_round_trips_bit_identical_under_the_checksum() {
     assert_eq!(got.unwrap().mode(2).unwrap().coefficients.len(), 9);
     // Plain readers see the same bank; the spec checksum covers the new tensors.
     assert_bit_identical(&bank, &ModeBank::from_bytes(&bytes).unwrap());
-    assert_eq!(spec_checksum(&bytes), SafeTensors::read_metadata(&bytes).unwrap().1.metadata().as_ref().unwrap()["checksum"]);
+    assert_eq!(
+        spec_checksum(&bytes),
+        SafeTensors::read_metadata(&bytes).unwrap().1.metadata().as_ref().unwrap()["checksum"]
+    );
     let mut flipped = bytes.clone();
     let n = flipped.len();
     flipped[n - 3] ^= 0x10; // inside radiation_coefficients or another tensor: caught

@@ -34,7 +34,8 @@ pub(crate) struct RadiationMeta {
 pub(crate) fn tensors(table: &RadiationTable) -> Vec<(&'static str, Dtype, Vec<usize>, Vec<u8>)> {
     let r = table.modes.len();
     let f64s = |v: &mut dyn Iterator<Item = f64>| v.flat_map(f64::to_le_bytes).collect::<Vec<u8>>();
-    let i64s = |v: &mut dyn Iterator<Item = usize>| v.flat_map(|x| (x as i64).to_le_bytes()).collect::<Vec<u8>>();
+    let i64s =
+        |v: &mut dyn Iterator<Item = usize>| v.flat_map(|x| (x as i64).to_le_bytes()).collect::<Vec<u8>>();
     let c: usize = table.modes.iter().map(|m| m.coefficients.len()).sum();
     vec![
         (T_RAD_MODES, Dtype::I64, vec![r], i64s(&mut table.modes.iter().map(|m| m.mode))),
@@ -61,16 +62,25 @@ pub(crate) fn metadata(table: &RadiationTable) -> Result<String, BankError> {
         tolerance: table.tolerance,
         convention: "exp(-i omega t)".into(),
     };
-    serde_json::to_string(&meta).map_err(|e| BankError::BadMetadata { key: KEY_RADIATION.into(), detail: e.to_string() })
+    serde_json::to_string(&meta)
+        .map_err(|e| BankError::BadMetadata { key: KEY_RADIATION.into(), detail: e.to_string() })
 }
 
 fn read_f64(st: &SafeTensors<'_>, name: &str, len: usize) -> Result<Vec<f64>, BankError> {
     let t = st.tensor(name).map_err(|_| BankError::MissingTensor(name.into()))?;
     if t.dtype() != Dtype::F64 {
-        return Err(BankError::WrongDtype { name: name.into(), found: t.dtype().to_string(), expected: "F64".into() });
+        return Err(BankError::WrongDtype {
+            name: name.into(),
+            found: t.dtype().to_string(),
+            expected: "F64".into(),
+        });
     }
     if t.data().len() != 8 * len {
-        return Err(BankError::WrongShape { name: name.into(), found: t.shape().to_vec(), expected: format!("{len} values") });
+        return Err(BankError::WrongShape {
+            name: name.into(),
+            found: t.shape().to_vec(),
+            expected: format!("{len} values"),
+        });
     }
     Ok(t.data().chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap_or([0; 8]))).collect())
 }
@@ -78,7 +88,11 @@ fn read_f64(st: &SafeTensors<'_>, name: &str, len: usize) -> Result<Vec<f64>, Ba
 fn read_usize(st: &SafeTensors<'_>, name: &str) -> Result<Vec<usize>, BankError> {
     let t = st.tensor(name).map_err(|_| BankError::MissingTensor(name.into()))?;
     if t.dtype() != Dtype::I64 || t.shape().len() != 1 {
-        return Err(BankError::WrongDtype { name: name.into(), found: t.dtype().to_string(), expected: "I64".into() });
+        return Err(BankError::WrongDtype {
+            name: name.into(),
+            found: t.dtype().to_string(),
+            expected: "I64".into(),
+        });
     }
     t.data()
         .chunks_exact(8)
@@ -98,7 +112,8 @@ fn read_usize(st: &SafeTensors<'_>, name: &str) -> Result<Vec<usize>, BankError>
 /// `None` when the file has none.
 pub(crate) fn read(bytes: &[u8], mode_count: usize) -> Result<Option<RadiationTable>, BankError> {
     let st = SafeTensors::deserialize(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
-    let (_, header) = SafeTensors::read_metadata(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
+    let (_, header) =
+        SafeTensors::read_metadata(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
     let Some(json) = header.metadata().as_ref().and_then(|m| m.get(KEY_RADIATION)) else {
         return Ok(None);
     };
@@ -108,7 +123,11 @@ pub(crate) fn read(bytes: &[u8], mode_count: usize) -> Result<Option<RadiationTa
     let orders = read_usize(&st, T_RAD_ORDERS)?;
     let r = modes.len();
     if orders.len() != r {
-        return Err(BankError::WrongShape { name: T_RAD_ORDERS.into(), found: vec![orders.len()], expected: format!("[{r}]") });
+        return Err(BankError::WrongShape {
+            name: T_RAD_ORDERS.into(),
+            found: vec![orders.len()],
+            expected: format!("[{r}]"),
+        });
     }
     let wavenumbers = read_f64(&st, T_RAD_WAVENUMBERS, r)?;
     let power = read_f64(&st, T_RAD_POWER, r)?;
@@ -116,9 +135,14 @@ pub(crate) fn read(bytes: &[u8], mode_count: usize) -> Result<Option<RadiationTa
     // Each order bounded by the file size before multiplying.
     let mut total = 0usize;
     for (i, &l) in orders.iter().enumerate() {
-        let n = l.checked_add(1).and_then(|n| n.checked_mul(n)).filter(|&n| n <= bytes.len() / 16).ok_or_else(|| {
-            BankError::OutOfRange { field: format!("{T_RAD_ORDERS}[{i}]"), value: l as f64, rule: "too large for the file".into() }
-        })?;
+        let n =
+            l.checked_add(1).and_then(|n| n.checked_mul(n)).filter(|&n| n <= bytes.len() / 16).ok_or_else(
+                || BankError::OutOfRange {
+                    field: format!("{T_RAD_ORDERS}[{i}]"),
+                    value: l as f64,
+                    rule: "too large for the file".into(),
+                },
+            )?;
         total = total.saturating_add(n);
     }
     let flat = read_f64(&st, T_RAD_COEFFICIENTS, total.saturating_mul(2))?;
