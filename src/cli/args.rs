@@ -259,12 +259,25 @@ pub struct RetuneArgs {
 }
 
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["vtk", "faust"])))]
 pub struct ExportArgs {
     /// Mode bank.
     pub bank: PathBuf,
     /// VTK XML unstructured grid to write (ParaView).
     #[arg(long, value_name = "OUT.vtu")]
-    pub vtk: PathBuf,
+    pub vtk: Option<PathBuf>,
+    /// Faust library to write: a mesh2faust-style modal model excited at the --at points.
+    #[arg(long, value_name = "OUT.lib", requires = "at")]
+    pub faust: Option<PathBuf>,
+    /// Excitation position X,Y,Z [m] of the Faust model (snapped to the surface); repeat: exPos 0, 1, …
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "faust")]
+    pub at: Vec<[f64; 3]>,
+    /// Name of the Faust model function (default: modalModel, as mesh2faust).
+    #[arg(long, value_name = "NAME", requires = "faust")]
+    pub faust_name: Option<String>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Args)]

@@ -1,13 +1,12 @@
-//! `modal info`, `modal retune`, `modal export`: commands on an existing bank.
+//! `modal info`, `modal retune`: commands on an existing bank (`modal export`: export.rs).
 
 use anyhow::{Context, Result};
 use modal_bank::{ModeBank, RetuneSpec};
 
-use super::args::{ExportArgs, InfoArgs, RetuneArgs};
+use super::args::{InfoArgs, RetuneArgs};
 use super::bank_report::BankJson;
 use super::interrupt;
 use super::output::print_json;
-use super::write_atomic;
 
 /// Loads a bank, naming the file in the error.
 pub fn load_bank(path: &std::path::Path) -> Result<ModeBank> {
@@ -65,22 +64,4 @@ fn retuned_material(bank: &ModeBank, args: &RetuneArgs) -> Result<modal_fem::Mat
     material.beta = m.beta.unwrap_or(material.beta);
     material.validate()?;
     Ok(material)
-}
-
-pub fn export(args: ExportArgs) -> Result<()> {
-    let bank = load_bank(&args.bank)?;
-    write_atomic(&args.vtk, |tmp| {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-        modal_bank::export_vtu(&bank, &mut file)?;
-        std::io::Write::flush(&mut file)?;
-        Ok(())
-    })
-    .with_context(|| format!("cannot write {}", args.vtk.display()))?;
-    println!(
-        "wrote {} ({} modes on {} surface nodes)",
-        args.vtk.display(),
-        bank.mode_count(),
-        bank.surface_node_count()
-    );
-    Ok(())
 }

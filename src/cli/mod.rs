@@ -6,6 +6,7 @@ mod args;
 mod bank_cmds;
 mod bank_report;
 mod bench;
+mod export;
 mod interrupt;
 mod material;
 mod mesh;
@@ -46,7 +47,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::ExportMatrices(args)) => precompute::export_matrices(args),
         Some(Command::Info(args)) => bank_cmds::info(args),
         Some(Command::Retune(args)) => bank_cmds::retune(args),
-        Some(Command::Export(args)) => bank_cmds::export(args),
+        Some(Command::Export(args)) => export::run(args),
         Some(Command::Mesh(args)) => mesh::run(args.shape),
         Some(Command::Strike(args)) => strike::run(args),
         Some(Command::Render(args)) => render::run(args),

@@ -1,0 +1,16 @@
+//! `modal-export`: mode banks out to the tools people already use.
+//!
+//! Input: a validated [`modal_bank::ModeBank`]. Outputs:
+//! - [`faust`]: a Faust modal model in the form mesh2faust writes
+//!   (`pm.modeFilter` per mode; frequencies, T60s and one row of gains per
+//!   excitation position), see `docs/faust.md`.
+//!
+//! Library code only: every function returns a typed [`ExportError`] and
+//! never prints; the `modal export` command writes the files atomically.
+
+#![warn(missing_docs)]
+
+mod error;
+pub mod faust;
+
+pub use error::ExportError;

@@ -1,0 +1,105 @@
+//! `modal export`: a bank out to other tools — ParaView (`--vtk`) and Faust
+//! (`--faust` with `--at`). Every file is written atomically; with several
+//! formats, each is written in turn and the summary lists what was written.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use modal_bank::ModeBank;
+use modal_export::faust::{FaustModel, DEFAULT_NAME};
+use serde_json::{json, Value};
+
+use super::args::ExportArgs;
+use super::bank_cmds::load_bank;
+use super::output::print_json;
+use super::write_atomic;
+
+/// Writes a file through `write`, atomically, naming it in the error.
+fn write_file(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    write_atomic(path, |tmp| {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        write(&mut file)?;
+        file.flush()?;
+        Ok(())
+    })
+    .with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn vtk(bank: &ModeBank, path: &Path) -> Result<Value> {
+    write_file(path, |w| Ok(modal_bank::export_vtu(bank, w)?))?;
+    let line = format!(
+        "wrote {} ({} modes on {} surface nodes)",
+        path.display(),
+        bank.mode_count(),
+        bank.surface_node_count()
+    );
+    Ok(json!({ "path": path.display().to_string(), "summary": line }))
+}
+
+fn faust(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
+    let name = args.faust_name.as_deref().unwrap_or(DEFAULT_NAME);
+    let model = FaustModel::new(bank, &args.at, name).context("--faust")?;
+    let source = args.bank.file_name().map_or_else(|| "a bank".into(), |n| n.to_string_lossy().into_owned());
+    write_file(path, |w| Ok(model.write(w, &source)?))?;
+    let mut line = format!(
+        "wrote {} (Faust {}(exPos,t60Scale): {} modes, {} excitation positions",
+        path.display(),
+        model.name,
+        model.mode_count(),
+        model.positions.len()
+    );
+    if model.skipped_modes > 0 {
+        line.push_str(&format!(", {} overdamped modes left out", model.skipped_modes));
+    }
+    line.push(')');
+    for (k, e) in model.positions.iter().enumerate() {
+        let [x, y, z] = e.surface_point;
+        line.push_str(&format!(
+            "\n  exPos {k}: surface point ({x:.6}, {y:.6}, {z:.6}) m, {:.3} mm from the requested point",
+            e.distance_m * 1e3
+        ));
+    }
+    let positions: Vec<Value> = model
+        .positions
+        .iter()
+        .map(|e| {
+            json!({
+                "requested": e.requested,
+                "surface_point": e.surface_point,
+                "distance_m": e.distance_m,
+                "normal": e.normal,
+                "gain_scale": e.scale,
+            })
+        })
+        .collect();
+    Ok(json!({
+        "path": path.display().to_string(),
+        "name": model.name,
+        "modes": model.mode_count(),
+        "skipped_modes": model.skipped_modes,
+        "positions": positions,
+        "summary": line,
+    }))
+}
+
+pub fn run(args: ExportArgs) -> Result<()> {
+    let bank = load_bank(&args.bank)?;
+    let mut report = serde_json::Map::new();
+    report.insert("bank".into(), json!(args.bank.display().to_string()));
+    if let Some(path) = &args.vtk {
+        report.insert("vtk".into(), vtk(&bank, path)?);
+    }
+    if let Some(path) = &args.faust {
+        report.insert("faust".into(), faust(&bank, &args, path)?);
+    }
+    if args.json {
+        return print_json(&report);
+    }
+    for value in report.values() {
+        if let Some(line) = value.get("summary").and_then(Value::as_str) {
+            println!("{line}");
+        }
+    }
+    Ok(())
+}
