@@ -286,7 +286,9 @@ impl DrivenVoice {
         if seg.oversample == 0 || seg.oversample > MAX_OVERSAMPLE {
             return Err(SynthError::InvalidOption { name: "oversample", value: seg.oversample as f64 });
         }
-        if let Some(f) = seg.forces.iter().find(|f| !f.iter().all(|x| x.is_finite() && x.abs() <= MAX_FORCE_N)) {
+        if let Some(f) =
+            seg.forces.iter().find(|f| !f.iter().all(|x| x.is_finite() && x.abs() <= MAX_FORCE_N))
+        {
             return Err(SynthError::InvalidForce(*f));
         }
         let m = seg.oversample as u64;
@@ -324,8 +326,8 @@ impl DrivenVoice {
         let mut coef = vec![[0.0; 3]; n];
         for (c, e) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].into_iter().enumerate() {
             self.model.shapes_dot(&point, e, &mut self.phi);
-            for i in 0..n {
-                coef[i][c] = self.phi[i];
+            for (k, x) in coef.iter_mut().zip(&self.phi) {
+                k[c] = *x;
             }
         }
         let last_knot = seg.start + seg.forces.len() as u64 - 1;
@@ -346,8 +348,8 @@ impl DrivenVoice {
         } else {
             Vec::new()
         };
-        for i in 0..n {
-            if self.enabled[i] && coef[i] != [0.0; 3] && !self.is_active[i] {
+        for (i, c) in coef.iter().enumerate() {
+            if self.enabled[i] && *c != [0.0; 3] && !self.is_active[i] {
                 self.is_active[i] = true;
                 self.active.push(i);
             }
@@ -396,7 +398,7 @@ impl DrivenVoice {
 
     fn render_span_into(&mut self, out: &mut [f32], start_sample: u64) {
         if !self.pending_sorted {
-            self.pending.sort_unstable_by(|a, b| (b.0, b.1).cmp(&(a.0, a.1)));
+            self.pending.sort_unstable_by_key(|p| std::cmp::Reverse((p.0, p.1)));
             self.pending_sorted = true;
         }
         let end = start_sample + out.len() as u64;

@@ -149,8 +149,14 @@ fn test_segments() -> Vec<ForceSegment> {
     // Chained per-"step" segments at moving points, plus an overlapping one.
     for k in 0..12u64 {
         let x = [0.02 + 0.02 * k as f64, 0.02, 0.004];
-        let forces = (0..49).map(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)]).collect();
-        segs.push(ForceSegment { start: 300 + 48 * k, oversample: 1, point: ImpactPoint::Position(x), forces });
+        let forces =
+            (0..49).map(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)]).collect();
+        segs.push(ForceSegment {
+            start: 300 + 48 * k,
+            oversample: 1,
+            point: ImpactPoint::Position(x),
+            forces,
+        });
     }
     let forces = (0..800).map(|i| [0.0, (i as f64 * 0.01).sin(), 0.0]).collect();
     segs.push(ForceSegment { start: 1000, oversample: 1, point: ImpactPoint::Position(AT), forces });
@@ -225,7 +231,8 @@ fn bad_force_input_is_refused() {
     v.render(&mut out, 0);
     let err = v.add_segment(seg(vec![[1.0; 3]; 3], 50, 1)).unwrap_err();
     assert!(err.to_string().contains("before the render position"), "{err}");
-    let far = ForceSegment { point: ImpactPoint::Position([9.0, 9.0, 9.0]), ..seg(vec![[1.0; 3]; 3], 200, 1) };
+    let far =
+        ForceSegment { point: ImpactPoint::Position([9.0, 9.0, 9.0]), ..seg(vec![[1.0; 3]; 3], 200, 1) };
     assert!(matches!(v.add_segment(far).unwrap_err(), SynthError::PointFarFromSurface { .. }));
     assert!(v.is_silent());
 }
