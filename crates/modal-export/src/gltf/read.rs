@@ -38,7 +38,9 @@ pub struct Imported {
 
 /// Whether `path` names a glTF file (`.glb` or `.gltf`, any case).
 pub fn is_gltf_path(path: &Path) -> bool {
-    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
 }
 
 /// Reads the modal model of a `.glb`, or of a `.gltf` whose buffers are
@@ -137,7 +139,10 @@ impl Doc {
         let mut buffers = Vec::new();
         for buffer in gltf.buffers() {
             let data = match buffer.source() {
-                gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| bad("buffer 0 is the GLB chunk, but the file has none"))?,
+                gltf::buffer::Source::Bin => gltf
+                    .blob
+                    .clone()
+                    .ok_or_else(|| bad("buffer 0 is the GLB chunk, but the file has none"))?,
                 gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                     return Err(bad("data: URI buffers are not supported (write a .glb)"))
                 }
@@ -169,7 +174,8 @@ impl Doc {
         dims: gltf::accessor::Dimensions,
         components: &[u32],
     ) -> Result<Vec<T>, ExportError> {
-        let accessor = self.gltf.accessors().nth(index).ok_or_else(|| bad(format!("{what}: no accessor {index}")))?;
+        let accessor =
+            self.gltf.accessors().nth(index).ok_or_else(|| bad(format!("{what}: no accessor {index}")))?;
         let component = accessor.data_type().as_gl_enum();
         if accessor.dimensions() != dims || !components.contains(&component) {
             return Err(bad(format!(
@@ -219,7 +225,8 @@ fn vec3_list(doc: &Doc, index: usize, what: &str) -> Result<Vec<[f32; 3]>, Expor
 
 fn index_list(doc: &Doc, index: usize) -> Result<Vec<u32>, ExportError> {
     let scalar = gltf::accessor::Dimensions::Scalar;
-    let accessor = doc.gltf.accessors().nth(index).ok_or_else(|| bad(format!("indices: no accessor {index}")))?;
+    let accessor =
+        doc.gltf.accessors().nth(index).ok_or_else(|| bad(format!("indices: no accessor {index}")))?;
     if accessor.data_type().as_gl_enum() == UNSIGNED_SHORT {
         let short: Vec<u16> = doc.read(index, "indices", scalar, &[UNSIGNED_SHORT])?;
         Ok(short.into_iter().map(u32::from).collect())
@@ -244,7 +251,8 @@ fn root_extension(doc: &Doc) -> Result<(&'static str, &'static str, &Value), Exp
 fn pick_model(doc: &Doc, ext: &str, key: &str, count: usize) -> Result<(usize, f64), ExportError> {
     for node in doc.gltf.nodes() {
         if let Some(model) = node.extension_value(ext).and_then(|v| v.get(key)).and_then(Value::as_u64) {
-            let gain = node.extension_value(ext).and_then(|v| v.get("gain")).and_then(Value::as_f64).unwrap_or(1.0);
+            let gain =
+                node.extension_value(ext).and_then(|v| v.get("gain")).and_then(Value::as_f64).unwrap_or(1.0);
             let model = model as usize;
             if model >= count {
                 return Err(bad(format!("node {} names model {model}, the file has {count}", node.index())));
@@ -260,9 +268,12 @@ fn pick_model(doc: &Doc, ext: &str, key: &str, count: usize) -> Result<(usize, f
 }
 
 fn material(root: &RootJson, model: &ModelJson) -> Result<Material, ExportError> {
-    let index = model.material.ok_or_else(|| bad("the model names no acoustic material (modal needs ρ, E, ν)"))?;
-    let m = root.materials.get(index).ok_or_else(|| bad(format!("acoustic material {index} does not exist")))?;
-    let need = |v: Option<f64>, what: &str| v.ok_or_else(|| bad(format!("acoustic material {index} has no {what}")));
+    let index =
+        model.material.ok_or_else(|| bad("the model names no acoustic material (modal needs ρ, E, ν)"))?;
+    let m =
+        root.materials.get(index).ok_or_else(|| bad(format!("acoustic material {index} does not exist")))?;
+    let need =
+        |v: Option<f64>, what: &str| v.ok_or_else(|| bad(format!("acoustic material {index} has no {what}")));
     let material = Material {
         name: m.name.clone(),
         youngs_pa: need(m.youngs_modulus, "youngsModulus")?,
@@ -284,8 +295,14 @@ fn mass_properties(model: &ModelJson, density: f64, warnings: &mut Vec<String>) 
             inertia_kg_m2: inertia::tensor(m.inertia_diagonal, m.inertia_orientation),
         },
         None => {
-            warnings.push("the model has no massProperties: mass, centre of mass and inertia read as 0".into());
-            MassProperties { volume_m3: 0.0, mass_kg: 0.0, center_of_mass_m: [0.0; 3], inertia_kg_m2: [[0.0; 3]; 3] }
+            warnings
+                .push("the model has no massProperties: mass, centre of mass and inertia read as 0".into());
+            MassProperties {
+                volume_m3: 0.0,
+                mass_kg: 0.0,
+                center_of_mass_m: [0.0; 3],
+                inertia_kg_m2: [[0.0; 3]; 3],
+            }
         }
     }
 }
@@ -317,7 +334,12 @@ fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
     if let Some(i) = decays.iter().position(|&d| d < 0.0) {
         return Err(bad(format!("decayRates[{i}] = {} 1/s is negative", decays[i])));
     }
-    let indices = index_list(&doc, model.indices.ok_or_else(|| bad("the model has no indices (modal strikes a triangulated surface)"))?)?;
+    let indices = index_list(
+        &doc,
+        model
+            .indices
+            .ok_or_else(|| bad("the model has no indices (modal strikes a triangulated surface)"))?,
+    )?;
     if indices.len() % 3 != 0 {
         return Err(bad(format!("indices has {} values, not a multiple of 3", indices.len())));
     }
@@ -327,7 +349,9 @@ fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
     let material = material(&root, model)?;
     if let Some(exact) = model.extras.as_ref().and_then(|e| e.get(EXTRAS_KEY)) {
         match exact_bank(&doc, exact, &freqs, &decays, &positions, &shapes) {
-            Ok(bank) => return Ok(Imported { bank, exact: true, model: index, name: model.name.clone(), warnings }),
+            Ok(bank) => {
+                return Ok(Imported { bank, exact: true, model: index, name: model.name.clone(), warnings })
+            }
             Err(why) => warnings.push(format!("extras.{EXTRAS_KEY} is ignored: {why}")),
         }
     }
@@ -354,7 +378,10 @@ fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
         surface: Surface {
             node_ids: (0..s).collect(),
             positions: positions.iter().map(|p| p.map(f64::from)).collect(),
-            triangles: indices.chunks_exact(3).map(|t| [t[0] as usize, t[1] as usize, t[2] as usize]).collect(),
+            triangles: indices
+                .chunks_exact(3)
+                .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])
+                .collect(),
             triangle_edge_nodes: None,
         },
         material,

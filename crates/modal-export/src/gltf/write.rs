@@ -23,7 +23,7 @@ struct Layout {
 impl Layout {
     /// Appends `bytes` as a buffer view (8-byte aligned); returns its index.
     fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 8 != 0 {
+        while !self.bin.len().is_multiple_of(8) {
             self.bin.push(0);
         }
         let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
@@ -36,7 +36,14 @@ impl Layout {
     }
 
     /// Adds an accessor over a whole view; returns its index.
-    fn accessor(&mut self, view: usize, component: u32, count: usize, kind: &str, bounds: Option<Value>) -> usize {
+    fn accessor(
+        &mut self,
+        view: usize,
+        component: u32,
+        count: usize,
+        kind: &str,
+        bounds: Option<Value>,
+    ) -> usize {
         let mut a = json!({ "bufferView": view, "componentType": component, "count": count, "type": kind });
         if let Some(Value::Array(b)) = bounds {
             a["min"] = b[0].clone();
@@ -104,7 +111,8 @@ pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, 
         return Err(too_big("surface nodes × modes"));
     }
     let mut layout = Layout::default();
-    let positions = layout.floats(bank.surface.positions.iter().flatten().map(|&x| x as f32), "VEC3", Some(ARRAY_BUFFER));
+    let positions =
+        layout.floats(bank.surface.positions.iter().flatten().map(|&x| x as f32), "VEC3", Some(ARRAY_BUFFER));
     let indices: Vec<u32> = triangles.iter().flatten().map(|&i| i as u32).collect();
     let index_view = layout.view(&le_bytes(&indices, u32::to_le_bytes), Some(ELEMENT_ARRAY_BUFFER));
     let indices = layout.accessor(index_view, UNSIGNED_INT, triangles.len() * 3, "SCALAR", None);
@@ -199,10 +207,10 @@ fn exact_side_data(bank: &ModeBank, layout: &mut Layout) -> Value {
 /// Packs a document and its binary buffer into GLB bytes.
 fn glb(document: &Value, mut bin: Vec<u8>) -> Result<Vec<u8>, ExportError> {
     let mut json = document.to_string().into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();

@@ -79,7 +79,7 @@ fn split_glb(bytes: &[u8]) -> (Value, Vec<u8>) {
 /// GLB bytes of a JSON document and a binary chunk.
 fn join_glb(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut text = json.to_string().into_bytes();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();
@@ -117,7 +117,10 @@ fn the_gltf_crate_reads_the_mesh_and_the_documented_accessors() {
     assert!(used.iter().all(|&u| u));
     let node = gltf.nodes().next().unwrap();
     assert_eq!(node.mesh().unwrap().index(), 0);
-    assert_eq!(node.extension_value(EXTENSION).unwrap(), &serde_json::json!({ "modalModel": 0, "gain": 1.0 }));
+    assert_eq!(
+        node.extension_value(EXTENSION).unwrap(),
+        &serde_json::json!({ "modalModel": 0, "gain": 1.0 })
+    );
     assert_eq!(gltf.extensions_used().collect::<Vec<_>>(), vec![EXTENSION]);
     assert_eq!(gltf.extensions_required().count(), 0);
     let root = gltf.extension_value(EXTENSION).unwrap();
@@ -184,7 +187,11 @@ fn edited_side_data_is_ignored_with_a_warning() {
     json["extensions"][EXTENSION]["modalModels"][0]["extras"]["modal"]["frequenciesHz"][2] = 1234.5.into();
     let imported = import_glb(&join_glb(&json, &bin)).unwrap();
     assert!(!imported.exact);
-    assert!(imported.warnings.iter().any(|w| w.contains("extras.modal is ignored")), "{:?}", imported.warnings);
+    assert!(
+        imported.warnings.iter().any(|w| w.contains("extras.modal is ignored")),
+        "{:?}",
+        imported.warnings
+    );
     assert!((imported.bank.frequencies_hz[2] / bank.frequencies_hz[2] - 1.0).abs() < 2e-7);
 }
 
@@ -210,7 +217,7 @@ fn modes_out_of_order_are_sorted() {
     let n = bank.mode_count();
     let mut bin = bin;
     let mut add = |values: Vec<f32>, json: &mut Value| -> usize {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let offset = bin.len();
@@ -219,7 +226,9 @@ fn modes_out_of_order_are_sorted() {
         views.push(serde_json::json!({ "buffer": 0, "byteOffset": offset, "byteLength": 4 * n }));
         let view = views.len() - 1;
         let accessors = json["accessors"].as_array_mut().unwrap();
-        accessors.push(serde_json::json!({ "bufferView": view, "componentType": 5126, "count": n, "type": "SCALAR" }));
+        accessors.push(
+            serde_json::json!({ "bufferView": view, "componentType": 5126, "count": n, "type": "SCALAR" }),
+        );
         accessors.len() - 1
     };
     let f: Vec<f32> = (0..n).rev().map(|i| bank.damped_frequency_hz(i) as f32).collect();
