@@ -23,6 +23,11 @@ pub enum Command {
     ExportMatrices(ExportMatricesArgs),
     /// Compute the audible modes of a mesh and store them in a mode bank.
     Precompute(PrecomputeArgs),
+    /// Precompute the banks of every asset in a manifest (sharded for Slurm/Kubernetes), with a catalogue.
+    PrecomputeBatch(crate::cli::batch::PrecomputeBatchArgs),
+    /// Work with batch catalogues (merge the shards' catalogues).
+    #[command(subcommand)]
+    Catalogue(crate::cli::catalogue::CatalogueCommand),
     /// Show what a mode bank holds.
     Info(InfoArgs),
     /// Change a bank's material (same Poisson's ratio) or size without a new eigen solve.

@@ -5,7 +5,9 @@
 mod args;
 mod bank_cmds;
 mod bank_report;
+mod batch;
 mod bench;
+mod catalogue;
 mod export;
 mod interrupt;
 mod material;
@@ -45,6 +47,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         None => render::run(args::RenderArgs::default()),
         Some(Command::Precompute(args)) => precompute::run(args),
         Some(Command::ExportMatrices(args)) => precompute::export_matrices(args),
+        Some(Command::PrecomputeBatch(args)) => batch::run(args),
+        Some(Command::Catalogue(command)) => catalogue::run(command),
         Some(Command::Info(args)) => bank_cmds::info(args),
         Some(Command::Retune(args)) => bank_cmds::retune(args),
         Some(Command::Export(args)) => export::run(args),

@@ -1,0 +1,199 @@
+//! Running a batch: every asset through `modal-precompute` and the
+//! content-addressed cache, with a catalogue kept current on disk.
+//!
+//! Per asset: (1) a bank already in the output directory whose
+//! `input_hash` equals the asset's cache key is taken as finished (a killed
+//! run resumes even without a shared cache); (2) otherwise the pipeline runs,
+//! served from the cache when it holds the key (a damaged or torn cache entry
+//! is detected by the bank checksum and recomputed); (3) the bank is written
+//! atomically into the output directory. Any error, even a panic, becomes
+//! the asset's catalogue `status`; the batch goes on.
+//!
+//! The catalogue is rewritten atomically after every asset, listing the
+//! assets not finished yet under `pending`, so a killed run leaves an honest
+//! partial catalogue behind.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use modal_bank::{BankCache, ModeBank};
+use modal_precompute::cache_key;
+
+use crate::{Asset, BatchError, Catalogue, CatalogueEntry, Shard};
+
+/// How to run a batch.
+#[derive(Clone, Debug)]
+pub struct BatchOptions {
+    /// Directory receiving the banks and the catalogue.
+    pub out_dir: PathBuf,
+    /// The shared bank cache (`None`: no cache; only finished banks in
+    /// `out_dir` are reused).
+    pub cache: Option<BankCache>,
+    /// Assets solved at the same time (at least 1).
+    pub jobs: usize,
+    /// Recompute even what is cached or finished.
+    pub force: bool,
+    /// Solver threads per asset (`None`: the pipeline's default).
+    pub threads: Option<usize>,
+    /// The shard being run (names the catalogue file).
+    pub shard: Shard,
+}
+
+/// Progress of a batch, for the CLI's display.
+#[derive(Clone, Copy, Debug)]
+pub enum Event<'a> {
+    /// An asset was started.
+    Started {
+        /// The asset.
+        asset: &'a Asset,
+    },
+    /// An asset finished (successfully or not).
+    Finished {
+        /// The asset.
+        asset: &'a Asset,
+        /// Its catalogue entry.
+        entry: &'a CatalogueEntry,
+        /// Warnings for the user (mesh fixes, a damaged cache entry, ...).
+        warnings: &'a [String],
+    },
+}
+
+/// Runs `assets` (one shard's) and returns the final catalogue, also
+/// written to `out_dir`/[`Catalogue::file_name`]. Fails only when the
+/// catalogue cannot be written; failing assets are catalogue entries.
+pub fn run_batch(
+    assets: &[Asset],
+    options: &BatchOptions,
+    on_event: &(dyn Fn(Event<'_>) + Sync),
+) -> Result<Catalogue, BatchError> {
+    let path = options.out_dir.join(Catalogue::file_name(options.shard));
+    let pending: Vec<String> = assets.iter().map(|a| a.path.clone()).collect();
+    Catalogue::new(Vec::new(), pending.clone(), options.shard).save(&path)?;
+    struct State {
+        done: Vec<CatalogueEntry>,
+        pending: Vec<String>,
+        write_error: Option<BatchError>,
+    }
+    let state = Mutex::new(State { done: Vec::new(), pending, write_error: None });
+    let next = AtomicUsize::new(0);
+    let worker = || loop {
+        let i = next.fetch_add(1, Ordering::Relaxed);
+        let Some(asset) = assets.get(i) else { break };
+        on_event(Event::Started { asset });
+        let (entry, warnings) = run_asset(asset, options);
+        {
+            let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
+            s.done.push(entry.clone());
+            if let Some(at) = s.pending.iter().position(|p| *p == asset.path) {
+                s.pending.remove(at);
+            }
+            let snapshot = Catalogue::new(s.done.clone(), s.pending.clone(), options.shard);
+            if let Err(e) = snapshot.save(&path) {
+                s.write_error.get_or_insert(e);
+            }
+        }
+        on_event(Event::Finished { asset, entry: &entry, warnings: &warnings });
+    };
+    let jobs = options.jobs.clamp(1, assets.len().max(1));
+    std::thread::scope(|scope| {
+        for _ in 1..jobs {
+            scope.spawn(worker);
+        }
+        worker();
+    });
+    let s = state.into_inner().unwrap_or_else(|e| e.into_inner());
+    if let Some(e) = s.write_error {
+        return Err(e);
+    }
+    let catalogue = Catalogue::new(s.done, s.pending, options.shard);
+    catalogue.save(&path)?;
+    Ok(catalogue)
+}
+
+/// Runs one asset; never fails: errors (and panics) become the entry's status.
+pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<String>) {
+    let start = Instant::now();
+    let mut request = asset.request.clone();
+    request.threads = options.threads;
+    let hash = cache_key(&request).ok();
+    let mut warnings = asset.warnings.clone();
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        solve(asset, &request, hash.as_deref(), options, &mut warnings)
+    }))
+    .unwrap_or_else(|panic| {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(format!("internal error (please report): {what}"))
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    let entry = match outcome {
+        Ok((bank, cached)) => CatalogueEntry {
+            path: asset.path.clone(),
+            bank: Some(asset.bank.clone()),
+            hash: Some(bank.info.input_hash.clone()),
+            modes: bank.frequencies_hz.len(),
+            first_frequency_hz: bank.frequencies_hz.first().copied(),
+            seconds,
+            status: "ok".into(),
+            cached,
+        },
+        Err(status) => CatalogueEntry {
+            path: asset.path.clone(),
+            bank: None,
+            hash,
+            modes: 0,
+            first_frequency_hz: None,
+            seconds,
+            status,
+            cached: false,
+        },
+    };
+    (entry, warnings)
+}
+
+/// The bank of `asset` and whether it was reused (finished or cached).
+fn solve(
+    asset: &Asset,
+    request: &modal_precompute::Request,
+    hash: Option<&str>,
+    options: &BatchOptions,
+    warnings: &mut Vec<String>,
+) -> Result<(ModeBank, bool), String> {
+    let out = options.out_dir.join(&asset.bank);
+    if let (Some(hash), false, true) = (hash, options.force, out.exists()) {
+        match ModeBank::load(&out) {
+            Ok(bank) if bank.info.input_hash == hash => return Ok((bank, true)),
+            Ok(_) => {}
+            Err(e) => {
+                warnings.push(format!("{}: replacing the damaged bank {} ({e})", asset.path, out.display()))
+            }
+        }
+    }
+    let outcome = modal_precompute::precompute(request, options.cache.as_ref(), options.force, &mut |_| {})
+        .map_err(|e| chain(&e))?;
+    warnings.extend(outcome.warnings.iter().map(|w| format!("{}: {w}", asset.path)));
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    outcome.bank.save(&out).map_err(|e| format!("cannot write bank {}: {}", out.display(), chain(&e)))?;
+    Ok((outcome.bank, outcome.cached))
+}
+
+/// An error and its causes, `": "`-separated, each said once.
+fn chain(err: &dyn std::error::Error) -> String {
+    let mut text = err.to_string();
+    let mut source = err.source();
+    while let Some(cause) = source {
+        let s = cause.to_string();
+        if !text.contains(&s) {
+            text = format!("{text}: {s}");
+        }
+        source = cause.source();
+    }
+    text
+}

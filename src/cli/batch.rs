@@ -1,0 +1,171 @@
+//! `modal precompute-batch`: a manifest of assets → one bank each and a catalogue.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use modal_batch::{BatchOptions, Catalogue, Event, Manifest, Shard, ShardEnv};
+use serde::Serialize;
+
+use super::output::{print_json, warn};
+use super::precompute::open_cache;
+
+/// Precompute the mode banks of every asset in a manifest (one shard of it).
+#[derive(Debug, Args)]
+pub struct PrecomputeBatchArgs {
+    /// Manifest (TOML: [defaults], [[assets]], [[globs]]; see docs/asset-libraries.md).
+    pub manifest: PathBuf,
+    /// Output directory: one bank per asset and the catalogue.
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Run shard I of N (0-based, e.g. 0/3); default: from SLURM_ARRAY_TASK_ID or
+    /// JOB_COMPLETION_INDEX, else the whole manifest.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Number of shards for JOB_COMPLETION_INDEX (or MODAL_SHARD_COUNT); overrides SLURM_ARRAY_TASK_COUNT.
+    #[arg(long, value_name = "N")]
+    pub shard_count: Option<usize>,
+    /// Assets solved at the same time.
+    #[arg(long, short = 'j', value_name = "J", default_value_t = 1)]
+    pub jobs: usize,
+    /// Solver threads per asset (default: the pipeline's).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Cache directory (default $MODAL_CACHE_DIR, $XDG_CACHE_HOME/modal or ~/.cache/modal);
+    /// shards on several machines should share one.
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// Do not read or write the cache (finished banks in --out are still reused).
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Recompute everything, even what is cached or finished.
+    #[arg(long)]
+    pub force: bool,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `--json` prints: counts, then the catalogue's entries.
+#[derive(Serialize)]
+struct BatchJson<'a> {
+    catalogue: String,
+    shard: Option<modal_batch::ShardInfo>,
+    total: usize,
+    ok: usize,
+    failed: usize,
+    /// Assets reused from the cache or from finished banks (not solved in this run).
+    cached: usize,
+    /// Assets solved in this run.
+    computed: usize,
+    seconds: f64,
+    assets: &'a [modal_batch::CatalogueEntry],
+}
+
+pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
+    if args.jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    let (shard, from) =
+        Shard::select(args.shard.as_deref(), args.shard_count, |name| std::env::var(name).ok())?;
+    let manifest = Manifest::load(&args.manifest)?;
+    let (all, warnings) = manifest.resolve()?;
+    warnings.iter().for_each(|w| warn(w));
+    let assets: Vec<_> = all.into_iter().filter(|a| shard.owns(&a.bank)).collect();
+    let selection = match from {
+        ShardEnv::Whole => String::new(),
+        ShardEnv::Flag => format!("shard {shard} (--shard): "),
+        ShardEnv::Slurm => format!("shard {shard} (Slurm array): "),
+        ShardEnv::Kubernetes => format!("shard {shard} (JOB_COMPLETION_INDEX): "),
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let options = BatchOptions {
+        out_dir: args.out.clone(),
+        cache: open_cache(args.cache_dir.as_deref(), args.no_cache),
+        jobs: args.jobs,
+        force: args.force,
+        threads: args.threads,
+        shard,
+    };
+    let bar = progress_bar(assets.len() as u64, &selection);
+    let start = Instant::now();
+    let on_event = |event: Event<'_>| match event {
+        Event::Started { asset } => bar.set_message(asset.path.clone()),
+        Event::Finished { entry, warnings, .. } => {
+            bar.suspend(|| {
+                warnings.iter().for_each(|w| warn(w));
+                if !entry.is_ok() {
+                    warn(&format!("{} failed: {}", entry.path, entry.status));
+                }
+            });
+            bar.inc(1);
+        }
+    };
+    let catalogue = modal_batch::run_batch(&assets, &options, &on_event)?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let path = args.out.join(Catalogue::file_name(shard));
+    let cached = catalogue.assets.iter().filter(|e| e.cached).count();
+    let failed = catalogue.failed();
+    if args.json {
+        print_json(&BatchJson {
+            catalogue: path.display().to_string(),
+            shard: catalogue.shard,
+            total: catalogue.assets.len(),
+            ok: catalogue.assets.len() - failed,
+            failed,
+            cached,
+            computed: catalogue.assets.iter().filter(|e| e.is_ok() && !e.cached).count(),
+            seconds,
+            assets: &catalogue.assets,
+        })?;
+    } else {
+        write_table(&catalogue, &mut std::io::stdout().lock())?;
+        println!(
+            "{selection}{} assets: {} ok ({cached} reused), {failed} failed in {seconds:.1} s; wrote {}",
+            catalogue.assets.len(),
+            catalogue.assets.len() - failed,
+            path.display()
+        );
+    }
+    if failed > 0 {
+        bail!(
+            "{failed} of {} assets failed (their errors are in {})",
+            catalogue.assets.len(),
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+fn progress_bar(len: u64, prefix: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    let template =
+        format!("{prefix}{{bar:30}} {{pos}}/{{len}} [{{elapsed_precise}}, ETA {{eta_precise}}] {{wide_msg}}");
+    bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
+    bar.enable_steady_tick(Duration::from_millis(250));
+    bar
+}
+
+/// The summary table: one line per asset, failures with their message.
+fn write_table(catalogue: &Catalogue, out: &mut impl Write) -> std::io::Result<()> {
+    let width = catalogue.assets.iter().map(|e| e.path.len()).max().unwrap_or(4).max(4);
+    writeln!(
+        out,
+        "{:<width$}  {:>5}  {:>10}  {:>8}  {:<6}  status",
+        "path", "modes", "f1 [Hz]", "seconds", "reused"
+    )?;
+    for e in &catalogue.assets {
+        let f1 = e.first_frequency_hz.map_or("-".to_string(), |f| format!("{f:.1}"));
+        let reused = if e.cached { "yes" } else { "no" };
+        writeln!(
+            out,
+            "{:<width$}  {:>5}  {f1:>10}  {:>8.2}  {reused:<6}  {}",
+            e.path, e.modes, e.seconds, e.status
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,93 @@
+//! `modal catalogue merge`: join the catalogues of a batch's shards.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use serde::Serialize;
+
+use super::output::{print_json, warn};
+
+/// Work with batch catalogues.
+#[derive(Debug, Subcommand)]
+pub enum CatalogueCommand {
+    /// Join shard catalogues (catalogue-shard-I-of-N.json in each DIR, or files) into one.
+    Merge(MergeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Directories (all their catalogue-shard-I-of-N.json, else catalogue.json) or catalogue files.
+    #[arg(required = true, value_name = "DIR")]
+    pub inputs: Vec<PathBuf>,
+    /// Merged catalogue to write (banks are made relative to its directory).
+    #[arg(short, long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Write the merge even when shards are missing or unfinished (it is marked "complete": false).
+    #[arg(long)]
+    pub partial: bool,
+    /// Print one JSON summary on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct MergeJson {
+    catalogue: String,
+    inputs: Vec<String>,
+    assets: usize,
+    failed: usize,
+    pending: usize,
+    missing_shards: Vec<String>,
+    complete: bool,
+}
+
+pub fn run(command: CatalogueCommand) -> Result<()> {
+    match command {
+        CatalogueCommand::Merge(args) => merge(args),
+    }
+}
+
+fn merge(args: MergeArgs) -> Result<()> {
+    let out_dir =
+        args.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
+    let (merged, report) = modal_batch::merge(&args.inputs, out_dir)?;
+    if !merged.complete && !args.partial {
+        let mut why = report.missing.clone();
+        if !merged.pending.is_empty() {
+            why.push(format!("{} assets unfinished (e.g. {})", merged.pending.len(), merged.pending[0]));
+        }
+        if why.is_empty() {
+            why.push("an input catalogue is marked incomplete".into());
+        }
+        bail!(
+            "the catalogues are incomplete ({}); re-run the missing shards, or pass --partial",
+            why.join("; ")
+        );
+    }
+    report.missing.iter().for_each(|m| warn(&format!("missing {m}")));
+    merged.save(&args.out)?;
+    let summary = MergeJson {
+        catalogue: args.out.display().to_string(),
+        inputs: report.inputs.iter().map(|p| p.display().to_string()).collect(),
+        assets: merged.assets.len(),
+        failed: merged.failed(),
+        pending: merged.pending.len(),
+        missing_shards: report.missing,
+        complete: merged.complete,
+    };
+    if args.json {
+        print_json(&summary)
+    } else {
+        println!(
+            "merged {} catalogues: {} assets ({} failed{}) into {}",
+            summary.inputs.len(),
+            summary.assets,
+            summary.failed,
+            if summary.complete { "" } else { ", incomplete" },
+            summary.catalogue
+        );
+        Ok(())
+    }
+}
