@@ -143,6 +143,8 @@ pub enum MeshShape {
         #[command(flatten)]
         common: GenerateArgs,
     },
+    /// Write the generated corpus of real-world-like surface assets (OBJ).
+    Corpus(crate::cli::corpus::CorpusArgs),
     /// Tetrahedralize a surface mesh (OBJ, STL, PLY).
     Tet {
         /// Surface mesh to fill with tets.

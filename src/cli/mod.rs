@@ -8,6 +8,7 @@ mod bank_report;
 mod batch;
 mod bench;
 mod catalogue;
+mod corpus;
 mod export;
 mod interrupt;
 mod material;
