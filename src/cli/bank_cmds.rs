@@ -35,8 +35,8 @@ fn show_with(bank: &ModeBank, radiation: Option<&modal_bank::RadiationTable>, js
 }
 
 pub fn info(args: InfoArgs) -> Result<()> {
-    let (bank, radiation) = ModeBank::load_with_radiation(&args.bank)
-        .with_context(|| format!("cannot load bank {}", args.bank.display()))?;
+    let bank = load_bank(&args.bank)?;
+    let radiation = super::listener::stored_radiation(&args.bank)?;
     show_with(&bank, radiation.as_ref(), args.json)
 }
 

@@ -61,8 +61,7 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
     let audible: Vec<usize> = (0..bank.mode_count())
         .filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ)
         .collect();
-    let (_, table) = ModeBank::load_with_radiation(path)
-        .with_context(|| format!("cannot load bank {}", path.display()))?;
+    let table = stored_radiation(path)?;
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
         let mut gains = vec![0.0; bank.mode_count()];
@@ -110,6 +109,17 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
         path.display()
     ));
     Ok(ListenerGains { gains: estimate_gains(bank, x)?, source: TransferSource::Estimate })
+}
+
+/// The radiation table stored in the bank file at `path` (`None` for banks
+/// without one and for glTF files, which carry no radiation).
+pub fn stored_radiation(path: &Path) -> Result<Option<modal_bank::RadiationTable>> {
+    if modal_export::gltf::is_gltf_path(path) {
+        return Ok(None);
+    }
+    let (_, table) = ModeBank::load_with_radiation(path)
+        .with_context(|| format!("cannot load bank {}", path.display()))?;
+    Ok(table)
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
