@@ -295,3 +295,60 @@ fn strike_hears_the_listener_by_default_linearly_and_audibly() {
         .fails_with("inside the body");
     assert!(!dir.path().join("x.wav").exists());
 }
+
+#[test]
+fn coarse_panels_at_low_frequency_agree_with_the_full_resolution() {
+    // A 10× softer sphere: its modes near 500 Hz (ka ≈ 0.5) are solved on the
+    // corner triangles (a quarter of the panels) unless --full-resolution.
+    let dir = temp_dir();
+    let r = RADIUS.to_string();
+    modal(dir.path(), &["mesh", "sphere", "--radius", &r, "--h", "0.015", "--order", "2", "-o", "s.msh"])
+        .ok();
+    let args = [
+        "precompute",
+        "s.msh",
+        "-o",
+        "soft.bank",
+        "--modes",
+        "8",
+        "--no-cache",
+        "--youngs",
+        "1e7",
+        "--density",
+        "1000",
+        "--poisson",
+        "0.3",
+    ];
+    modal(dir.path(), &args).ok();
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "radiation",
+            "soft.bank",
+            "--point",
+            "0.2,0.1,-0.12",
+            "--mode",
+            "5",
+            "--mode",
+            "6",
+            "--json",
+        ];
+        a.extend(extra);
+        modal(dir.path(), &a).ok()
+    };
+    let (coarse, fine) = (run(&[]), run(&["--full-resolution"]));
+    let panels = |stderr: &str| -> usize {
+        let line = stderr.lines().find(|l| l.contains(" panels,")).unwrap_or_else(|| panic!("{stderr}"));
+        line.split(" on ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap()
+    };
+    assert_eq!(4 * panels(&coarse.stderr), panels(&fine.stderr), "{}\n{}", coarse.stderr, fine.stderr);
+    let (c, f) = (coarse.json(), fine.json());
+    for (a, b) in c["modes"].as_array().unwrap().iter().zip(f["modes"].as_array().unwrap()) {
+        let mag = |m: &serde_json::Value| {
+            m["pressure_pa"][0][0].as_f64().unwrap().hypot(m["pressure_pa"][0][1].as_f64().unwrap())
+        };
+        let db = 20.0 * (mag(a) / mag(b)).log10();
+        assert!(db.abs() < 0.5, "mode {}: coarse vs full resolution {db:.2} dB", a["index"]);
+        let (pa, pb) = (a["radiated_power_w"].as_f64().unwrap(), b["radiated_power_w"].as_f64().unwrap());
+        assert!((10.0 * (pa / pb).log10()).abs() < 0.5, "power {pa} vs {pb}");
+    }
+}

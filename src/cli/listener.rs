@@ -99,7 +99,7 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
         let mut gains = vec![0.0; bank.mode_count()];
         for r in &results {
-            gains[r.mode] = r.surface.pressure_at(&mesh, x)?.norm() / FULL_SCALE_PA;
+            gains[r.mode] = r.pressure_at(x)?.norm() / FULL_SCALE_PA;
         }
         return Ok(ListenerGains { gains, source: TransferSource::Solved });
     }

@@ -34,6 +34,9 @@ pub struct RadiationArgs {
     /// Only these modes (indices into the bank; repeatable); default: every audible mode.
     #[arg(long, value_name = "I")]
     pub mode: Vec<usize>,
+    /// Solve every mode on the full panel mesh (no coarser panels at low frequency).
+    #[arg(long)]
+    pub full_resolution: bool,
     /// Also write a copy of the bank with every solved mode's far-field
     /// representation stored in it (format version 2), for `info`, `strike`.
     #[arg(long, value_name = "OUT.bank")]
@@ -112,14 +115,15 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         mesh.len(),
         skipped.len()
     );
-    let opts = RadiationOptions { air, ..RadiationOptions::default() };
+    let opts =
+        RadiationOptions { air, adaptive_resolution: !args.full_resolution, ..RadiationOptions::default() };
     let results =
         modal_radiation::modes::radiate_modes_on(&bank, &mesh, &modes, &opts, &mut |p| eprintln!("{p}"))?;
     let mut out = Vec::with_capacity(results.len());
     for r in &results {
         let mut pressure = Vec::with_capacity(args.point.len());
         for p in &args.point {
-            let z = r.surface.pressure_at(&mesh, *p)?;
+            let z = r.pressure_at(*p)?;
             pressure.push([z.re, z.im]);
         }
         out.push(ModeJson {

@@ -69,6 +69,14 @@ pub enum RadiationError {
         /// Frequency [Hz].
         frequency_hz: f64,
     },
+    /// The surface has more panels than the dense solver takes.
+    #[error("the surface has {panels} panels, more than the dense solver's {max}: mesh the object coarser (larger --h)")]
+    TooManyPanels {
+        /// Panels of the solve.
+        panels: usize,
+        /// The limit.
+        max: usize,
+    },
     /// A mode index is out of range.
     #[error("mode {mode} does not exist (the bank has {count})")]
     NoSuchMode {

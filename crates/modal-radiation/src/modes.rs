@@ -12,6 +12,7 @@
 //! problem), by about `(l+1)·δf/f` in power for a degree-`l` multipole,
 //! i.e. < 0.04 dB at the default 10⁻³.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use faer::c64;
@@ -33,6 +34,10 @@ pub struct RadiationOptions {
     pub multipole_tolerance: f64,
     /// Boundary integral equation (Burton–Miller unless studying).
     pub formulation: Formulation,
+    /// Solve a quadratic bank on its corner triangles (a quarter of the
+    /// panels, 1/64 of the LU work) when the wavelength allows it
+    /// ([`COARSE_MAX_KH`]).
+    pub adaptive_resolution: bool,
 }
 
 impl Default for RadiationOptions {
@@ -42,6 +47,7 @@ impl Default for RadiationOptions {
             group_tolerance: 1e-3,
             multipole_tolerance: DEFAULT_TOLERANCE,
             formulation: Formulation::BurtonMiller,
+            adaptive_resolution: true,
         }
     }
 }
@@ -64,6 +70,16 @@ pub struct ModeRadiation {
     pub efficiency: f64,
     /// Far-field representation about the centre of mass.
     pub multipole: Multipole,
+    /// The panels `surface` lives on (the bank's fine or coarse panels).
+    pub mesh: Arc<BoundaryMesh>,
+}
+
+impl ModeRadiation {
+    /// Pressure at `x` in the air (representation formula on the mode's
+    /// panels) [Pa]; errors inside the body.
+    pub fn pressure_at(&self, x: [f64; 3]) -> Result<c64, RadiationError> {
+        self.surface.pressure_at(&self.mesh, x)
+    }
 }
 
 /// Progress of a run, for the caller to show.
@@ -77,6 +93,13 @@ pub struct Progress {
     pub modes: Vec<usize>,
     /// Its frequency [Hz].
     pub frequency_hz: f64,
+    /// Panels of the solve (fewer at low frequency, see [`COARSE_MAX_KH`]).
+    pub panels: usize,
+    /// The panels are too coarse for this frequency: `k·h` above
+    /// [`UNDER_RESOLVED_KH`] (even the finest panels), or the fine panels
+    /// exceed [`MAX_DENSE_PANELS`] and the coarse ones are above
+    /// it. Expect larger errors; mesh finer for such modes.
+    pub under_resolved: bool,
     /// Seconds spent in the solve (assembly + LU).
     pub solve_s: f64,
     /// Seconds spent in the multipole fit.
@@ -87,8 +110,15 @@ impl std::fmt::Display for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, solve {:.2} s, fit {:.2} s",
-            self.groups_done, self.groups, self.modes, self.frequency_hz, self.solve_s, self.fit_s
+            "radiation {}/{}: mode(s) {:?} at {:.1} Hz on {} panels{}, solve {:.2} s, fit {:.2} s",
+            self.groups_done,
+            self.groups,
+            self.modes,
+            self.frequency_hz,
+            self.panels,
+            if self.under_resolved { " (under-resolved: expect larger errors)" } else { "" },
+            self.solve_s,
+            self.fit_s
         )
     }
 }
@@ -116,6 +146,24 @@ pub const CREASE_ANGLE_DEG: f64 = 25.0;
 /// flat-panel average leaves torsional modes ≈ 50× more normal velocity
 /// energy than the exact radial normal; the quadratic normal matches it.)
 pub fn corner_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[[f64; 3]; 3]> {
+    let node = node_normals(bank, mesh);
+    mesh.panels.iter().map(|p| p.corners.map(|c| smooth_or_panel(node[c], p.normal))).collect()
+}
+
+/// The node's normal where it is within [`CREASE_ANGLE_DEG`] of the panel
+/// normal, else the panel normal.
+fn smooth_or_panel(node: [f64; 3], panel: [f64; 3]) -> [f64; 3] {
+    let cos_crease = CREASE_ANGLE_DEG.to_radians().cos();
+    if node != [0.0; 3] && dot(node, panel) >= cos_crease {
+        node
+    } else {
+        panel
+    }
+}
+
+/// Unit smooth-surface normal at every surface node (zero for nodes no
+/// panel touches): see [`corner_normals`].
+pub fn node_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[f64; 3]> {
     let mut node = vec![[0.0; 3]; mesh.vertices.len()];
     match &bank.surface.triangle_edge_nodes {
         Some(edges) if mesh.vertices.len() == bank.surface_node_count() => {
@@ -142,19 +190,14 @@ pub fn corner_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[[f64; 3]; 3]
             }
         }
     }
-    let cos_crease = CREASE_ANGLE_DEG.to_radians().cos();
-    mesh.panels
-        .iter()
-        .map(|p| {
-            p.corners.map(|c| {
-                let n = node[c];
-                let len = dot(n, n).sqrt();
-                if len > 0.0 && dot(n, p.normal) >= cos_crease * len {
-                    n.map(|x| x / len)
-                } else {
-                    p.normal
-                }
-            })
+    node.iter()
+        .map(|n| {
+            let len = dot(*n, *n).sqrt();
+            if len > 0.0 {
+                n.map(|x| x / len)
+            } else {
+                [0.0; 3]
+            }
         })
         .collect()
 }
@@ -250,6 +293,95 @@ pub fn radiate_modes(
     radiate_modes_on(bank, &mesh, modes, opts, progress)
 }
 
+/// Largest `k·h` (wavenumber times the longest panel edge) at which a
+/// quadratic bank is solved on its corner triangles instead of the four
+/// flat panels per triangle: ≥ 12 panels per wavelength. Measured on the
+/// FEM sphere bank (tests/radiation_cli.rs) within the 0.5 dB acceptance.
+pub const COARSE_MAX_KH: f64 = 0.5;
+
+/// `k·h` above which even the finest panels are flagged under-resolved
+/// (fewer than ~6 panels per wavelength).
+pub const UNDER_RESOLVED_KH: f64 = 1.0;
+
+/// Largest dense system solved (16 B × N² of memory: 6 000 panels ≈ 0.58 GB).
+/// A quadratic bank whose fine panels exceed it is solved on its corner
+/// triangles at every frequency (flagged in [`Progress::under_resolved`]).
+pub const MAX_DENSE_PANELS: usize = 6000;
+
+/// The panel meshes of a bank: fine (every surface node a panel corner)
+/// and, for quadratic banks, coarse (the corner triangles), with the
+/// normal velocity of a mode on each.
+struct Panels {
+    fine: Arc<BoundaryMesh>,
+    fine_normals: Vec<[[f64; 3]; 3]>,
+    /// Longest edge of the fine panels [m].
+    fine_h: f64,
+    /// Coarse mesh, its longest edge, and the mid-edge nodes of each panel.
+    coarse: Option<(Arc<BoundaryMesh>, f64, Vec<[usize; 3]>)>,
+    node_normals: Vec<[f64; 3]>,
+}
+
+impl Panels {
+    fn new(bank: &ModeBank, mesh: &BoundaryMesh, adaptive: bool) -> Result<Panels, RadiationError> {
+        let coarse = match (&bank.surface.triangle_edge_nodes, adaptive) {
+            (Some(edges), true) => {
+                let m = BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?;
+                let h = m.panels.iter().map(|p| p.diameter).fold(0.0, f64::max);
+                Some((Arc::new(m), h, edges.clone()))
+            }
+            _ => None,
+        };
+        Ok(Panels {
+            fine_h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
+            fine: Arc::new(mesh.clone()),
+            fine_normals: corner_normals(bank, mesh),
+            coarse,
+            node_normals: node_normals(bank, mesh),
+        })
+    }
+
+    /// The mesh to solve on at wavenumber `k`, and whether it is the coarse one.
+    /// The mesh to solve on at wavenumber `k`, whether it is the coarse
+    /// one, and whether it is too coarse for `k` (see [`Progress::under_resolved`]).
+    fn at(&self, k: f64) -> (&Arc<BoundaryMesh>, bool, bool) {
+        match &self.coarse {
+            Some((m, h, _)) if k * h <= COARSE_MAX_KH => (m, true, false),
+            Some((m, h, _)) if self.fine.len() > MAX_DENSE_PANELS => (m, true, k * h > UNDER_RESOLVED_KH),
+            _ => (&self.fine, false, k * self.fine_h > UNDER_RESOLVED_KH),
+        }
+    }
+
+    /// Normal velocity of `mode` on the fine or coarse panels. On a coarse
+    /// panel (a curved 6-node triangle) it is the mean of `φ·n` over the
+    /// three mid-edge nodes: the exact mean of a quadratic field over the
+    /// triangle (the corner shape functions integrate to zero).
+    fn velocity(&self, bank: &ModeBank, mode: usize, coarse: bool) -> Result<Vec<c64>, RadiationError> {
+        match (&self.coarse, coarse) {
+            (Some((m, _, edges)), true) => {
+                if mode >= bank.mode_count() {
+                    return Err(RadiationError::NoSuchMode { mode, count: bank.mode_count() });
+                }
+                Ok(m.panels
+                    .iter()
+                    .zip(edges)
+                    .map(|(p, e)| {
+                        let v: f64 = e
+                            .iter()
+                            .map(|&c| {
+                                let s = bank.shape_at(mode, c);
+                                let n = smooth_or_panel(self.node_normals[c], p.normal);
+                                dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
+                            })
+                            .sum();
+                        c64::new(v / 3.0, 0.0)
+                    })
+                    .collect())
+            }
+            _ => normal_velocity_with(bank, &self.fine, &self.fine_normals, mode),
+        }
+    }
+}
+
 /// [`radiate_modes`] on a given panel mesh of the bank's surface.
 pub fn radiate_modes_on(
     bank: &ModeBank,
@@ -259,14 +391,12 @@ pub fn radiate_modes_on(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Vec<ModeRadiation>, RadiationError> {
     let centre = bank.mass.center_of_mass_m;
-    let mut velocities = Vec::with_capacity(modes.len());
-    let normals = corner_normals(bank, mesh);
+    let panels = Panels::new(bank, mesh, opts.adaptive_resolution)?;
     for &m in modes {
-        let v = normal_velocity_with(bank, mesh, &normals, m)?;
+        let v = panels.velocity(bank, m, false)?;
         if v.iter().all(|z| z.norm() == 0.0) {
             return Err(RadiationError::NoSurfaceVelocity { mode: m });
         }
-        velocities.push((m, v));
     }
     let groups = frequency_groups(bank, modes, opts.group_tolerance);
     let mut out = Vec::with_capacity(modes.len());
@@ -274,10 +404,13 @@ pub fn radiate_modes_on(
         let (lo, hi) =
             (bank.frequencies_hz[group[0]], bank.frequencies_hz[*group.last().unwrap_or(&group[0])]);
         let f = (lo * hi).sqrt();
-        let fields: Vec<Vec<c64>> = group
-            .iter()
-            .map(|m| velocities.iter().find(|(i, _)| i == m).map(|(_, v)| v.clone()).unwrap_or_default())
-            .collect();
+        let k = 2.0 * std::f64::consts::PI * f / opts.air.sound_speed_m_s;
+        let (mesh, coarse, under_resolved) = panels.at(k);
+        if mesh.len() > MAX_DENSE_PANELS {
+            return Err(RadiationError::TooManyPanels { panels: mesh.len(), max: MAX_DENSE_PANELS });
+        }
+        let fields =
+            group.iter().map(|&m| panels.velocity(bank, m, coarse)).collect::<Result<Vec<_>, _>>()?;
         let t0 = Instant::now();
         let surfaces = solve(mesh, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
@@ -285,13 +418,15 @@ pub fn radiate_modes_on(
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
         let fit_s = t1.elapsed().as_secs_f64();
         for ((&mode, surface), multipole) in group.iter().zip(surfaces).zip(multipoles) {
+            let power_w = multipole.radiated_power(opts.air);
             out.push(ModeRadiation {
                 mode,
                 frequency_hz: bank.frequencies_hz[mode],
-                power_w: multipole.radiated_power(opts.air),
-                efficiency: multipole.radiated_power(opts.air) / surface.velocity_power_scale(mesh),
+                power_w,
+                efficiency: power_w / surface.velocity_power_scale(mesh),
                 surface,
                 multipole,
+                mesh: Arc::clone(mesh),
             });
         }
         progress(&Progress {
@@ -299,6 +434,8 @@ pub fn radiate_modes_on(
             groups: groups.len(),
             modes: group.clone(),
             frequency_hz: f,
+            panels: mesh.len(),
+            under_resolved,
             solve_s,
             fit_s,
         });
