@@ -86,24 +86,25 @@ pub fn face_parts(mesh: &TetMesh) -> FaceParts {
         }
     }
     let mut id_of_root = vec![usize::MAX; tets];
-    let mut part_of_tet = vec![0; tets];
     let mut sizes = Vec::new();
-    for e in 0..tets {
-        let r = find(&mut parent, e);
-        if id_of_root[r] == usize::MAX {
-            id_of_root[r] = sizes.len();
-            sizes.push(0);
-        }
-        part_of_tet[e] = id_of_root[r];
-        sizes[id_of_root[r]] += 1;
-    }
+    let part_of_tet: Vec<usize> = (0..tets)
+        .map(|e| {
+            let r = find(&mut parent, e);
+            if id_of_root[r] == usize::MAX {
+                id_of_root[r] = sizes.len();
+                sizes.push(0);
+            }
+            sizes[id_of_root[r]] += 1;
+            id_of_root[r]
+        })
+        .collect();
     // Parts at every corner node; a node with two or more is a hinge node.
     let mut at_node: Vec<Vec<usize>> = vec![Vec::new(); mesh.nodes.len()];
-    for e in 0..tets {
+    for (e, &p) in part_of_tet.iter().enumerate() {
         for n in mesh.cells.corners(e) {
             let list = &mut at_node[n];
-            if !list.contains(&part_of_tet[e]) {
-                list.push(part_of_tet[e]);
+            if !list.contains(&p) {
+                list.push(p);
             }
         }
     }

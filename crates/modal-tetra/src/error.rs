@@ -82,7 +82,7 @@ pub enum TetraError {
         limit: usize,
     },
     /// The surface encloses no volume at the chosen resolution.
-    #[error("no tets: the surface encloses no volume thicker than the cell size {cell_m:.3e} m; {hint}")]
+    #[error("no tets at cell size {cell_m:.3e} m: {hint}")]
     NoVolume {
         /// Cell size used (m).
         cell_m: f64,

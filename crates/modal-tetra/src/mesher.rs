@@ -127,14 +127,36 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
     let mut nodes = mesh.nodes;
     let limit = HINGED_DROP_FRACTION * tets.len() as f64;
+    // Clusters of pieces linked by hinges (chains included): each keeps its
+    // largest piece; the others that are small are dropped.
+    let mut cluster: Vec<usize> = (0..parts.count).collect();
+    fn root(c: &mut [usize], mut x: usize) -> usize {
+        while c[x] != x {
+            c[x] = c[c[x]];
+            x = c[x];
+        }
+        x
+    }
+    for h in &parts.hinges {
+        let (a, b) = (root(&mut cluster, h.parts[0]), root(&mut cluster, h.parts[1]));
+        cluster[a.max(b)] = a.min(b);
+    }
+    let mut largest = vec![usize::MAX; parts.count];
+    for p in 0..parts.count {
+        let r = root(&mut cluster, p);
+        if largest[r] == usize::MAX || parts.tets[p] > parts.tets[largest[r]] {
+            largest[r] = p;
+        }
+    }
     let mut drop = vec![false; parts.count];
     let mut places = Vec::new();
     for h in &parts.hinges {
-        let [a, b] = h.parts;
-        let (small, large) = if parts.tets[a] <= parts.tets[b] { (a, b) } else { (b, a) };
-        if parts.tets[small] < parts.tets[large] && parts.tets[small] as f64 <= limit && !drop[small] {
-            drop[small] = true;
-            places.push(h.at);
+        for p in h.parts {
+            let r = root(&mut cluster, p);
+            if p != largest[r] && parts.tets[p] as f64 <= limit && !drop[p] {
+                drop[p] = true;
+                places.push(h.at);
+            }
         }
     }
     let pieces = drop.iter().filter(|&&d| d).count();
@@ -233,14 +255,17 @@ pub fn tetrahedralize(
             (Some(s), Some(_)) => {
                 return Err(TetraError::NoVolume {
                     cell_m: h0,
-                    hint: format!("--cell {h:.3e} works ({} tets)", s.tets.len()),
+                    hint: format!(
+                        "the solid is thinner than the cell; --cell {h:.3e} works ({} tets)",
+                        s.tets.len()
+                    ),
                 });
             }
             (None, _) => {
                 return Err(TetraError::NoVolume {
                     cell_m: h0,
                     hint: format!(
-                        "cells down to {h:.3e} m found none either (is it an open sheet, or much thinner than its size?)"
+                        "the solid is thinner than the cell, and cells down to {h:.3e} m found none either (is it an open sheet, or much thinner than its size?)"
                     ),
                 });
             }
