@@ -18,7 +18,9 @@
 //!    lattice tets to the inside. Dihedral angles stay within [9°, 166°]
 //!    (checked by the tests on every output).
 //! 4. Hinges: small face-connected pieces that touch the rest only at an
-//!    edge or a vertex are dropped ([`HINGED_DROP_FRACTION`]).
+//!    edge or a vertex are dropped ([`HINGED_DROP_FRACTION`]); larger ones
+//!    get their own copies of the shared nodes (separate bodies), so no
+//!    output tets are joined by an edge or a vertex only.
 //! 5. Sharp features (module `features`): boundary nodes near sharp input
 //!    edges and corners are moved onto them when quality allows.
 //!

@@ -98,6 +98,9 @@ pub struct TetReport {
     pub hinged_pieces_dropped: usize,
     /// Tets in those pieces.
     pub hinged_tets_dropped: usize,
+    /// Contacts between larger pieces through edges or vertices only, split
+    /// so that the pieces are separate bodies (node copies).
+    pub hinges_split: usize,
     /// What the user should know about the mesh (one line each).
     pub warnings: Vec<String>,
 }
@@ -106,17 +109,20 @@ pub struct TetReport {
 /// only at edges or vertices is dropped when it holds at most this fraction
 /// of all tets: such pieces are lattice artefacts where the solid is thinner
 /// than the cell, and would be zero-stiffness mechanisms. Larger hinged
-/// pieces are kept (`modal_mesh::check` splits them into separate bodies).
+/// pieces are kept as separate bodies (their shared nodes are duplicated).
 pub const HINGED_DROP_FRACTION: f64 = 0.01;
 
 struct HingedDrop {
     pieces: usize,
     tets: usize,
-    warning: Option<String>,
+    split: usize,
+    warnings: Vec<String>,
 }
 
 /// Drops small hinged pieces (see [`HINGED_DROP_FRACTION`]) and the nodes
-/// only they used.
+/// only they used, then splits the remaining hinges (the pieces become
+/// separate bodies), so no two output tets share only an edge or a vertex
+/// without being joined through faces.
 fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     let mesh = TetMesh {
         nodes: std::mem::take(&mut stuffed.nodes),
@@ -125,7 +131,7 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     };
     let parts = modal_mesh::face_parts(&mesh);
     let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
-    let mut nodes = mesh.nodes;
+    let (mut nodes, mut tets) = (mesh.nodes, tets);
     let limit = HINGED_DROP_FRACTION * tets.len() as f64;
     // Clusters of pieces linked by hinges (chains included): each keeps its
     // largest piece; the others that are small are dropped.
@@ -160,41 +166,56 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
         }
     }
     let pieces = drop.iter().filter(|&&d| d).count();
-    if pieces == 0 {
-        stuffed.nodes = nodes;
-        stuffed.tets = tets;
-        return HingedDrop { pieces: 0, tets: 0, warning: None };
-    }
-    let kept: Vec<[usize; 4]> =
-        tets.iter().zip(&parts.part_of_tet).filter(|(_, &p)| !drop[p]).map(|(t, _)| *t).collect();
-    let dropped = tets.len() - kept.len();
-    let mut index = vec![usize::MAX; nodes.len()];
-    let mut next = 0;
-    for t in &kept {
-        for &v in t {
-            if index[v] == usize::MAX {
-                index[v] = next;
-                next += 1;
+    let mut warnings = Vec::new();
+    let mut dropped = 0;
+    if pieces > 0 {
+        let kept: Vec<[usize; 4]> =
+            tets.iter().zip(&parts.part_of_tet).filter(|(_, &p)| !drop[p]).map(|(t, _)| *t).collect();
+        dropped = tets.len() - kept.len();
+        let mut index = vec![usize::MAX; nodes.len()];
+        let mut next = 0;
+        for t in &kept {
+            for &v in t {
+                if index[v] == usize::MAX {
+                    index[v] = next;
+                    next += 1;
+                }
             }
         }
-    }
-    let mut compact = vec![[0.0; 3]; next];
-    for (v, &i) in index.iter().enumerate() {
-        if i != usize::MAX {
-            compact[i] = nodes[v];
+        let mut compact = vec![[0.0; 3]; next];
+        for (v, &i) in index.iter().enumerate() {
+            if i != usize::MAX {
+                compact[i] = nodes[v];
+            }
         }
+        nodes = compact;
+        tets = kept.into_iter().map(|t| t.map(|v| index[v])).collect();
+        let p = places[0];
+        warnings.push(format!(
+            "dropped {pieces} small piece(s) of the tet mesh ({dropped} tets) that hung on the rest by an edge or a \
+             vertex only, first near ({:.4}, {:.4}, {:.4}) m: the solid is thinner than the cell there (a smaller \
+             --cell keeps it)",
+            p[0], p[1], p[2]
+        ));
     }
-    nodes = compact;
-    stuffed.tets = kept.into_iter().map(|t| t.map(|v| index[v])).collect();
-    stuffed.nodes = nodes;
-    let p = places[0];
-    let warning = format!(
-        "dropped {pieces} small piece(s) of the tet mesh ({dropped} tets) that hung on the rest by an edge or a \
-         vertex only, first near ({:.4}, {:.4}, {:.4}) m: the solid is thinner than the cell there (a smaller \
-         --cell keeps it)",
-        p[0], p[1], p[2]
-    );
-    HingedDrop { pieces, tets: dropped, warning: Some(warning) }
+    // Larger hinged pieces become separate bodies: each gets its own nodes.
+    let mut mesh = TetMesh { nodes, cells: Cells::Tet4(tets), groups: Vec::new() };
+    let parts = modal_mesh::face_parts(&mesh);
+    let mut split = 0;
+    if !parts.hinges.is_empty() {
+        split = parts.hinges.len();
+        let added = modal_mesh::split_hinges(&mut mesh, &parts);
+        warnings.push(format!(
+            "{} pieces of the tet mesh touch only at edges or vertices ({added} nodes duplicated): {}; they are \
+             solved as separate bodies (a smaller --cell may join them through faces)",
+            parts.count,
+            modal_mesh::describe_hinges(&parts, 3)
+        ));
+    }
+    let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
+    stuffed.nodes = mesh.nodes;
+    stuffed.tets = tets;
+    HingedDrop { pieces, tets: dropped, split, warnings }
 }
 
 /// Tetrahedralizes the solid bounded by `surface` (see the crate doc).
@@ -294,7 +315,8 @@ pub fn tetrahedralize(
         feature_nodes_snapped,
         hinged_pieces_dropped: hinged.pieces,
         hinged_tets_dropped: hinged.tets,
-        warnings: warnings.into_iter().chain(hinged.warning).collect(),
+        hinges_split: hinged.split,
+        warnings: warnings.into_iter().chain(hinged.warnings).collect(),
     };
     let mesh = TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() };
     Ok((mesh, report))

@@ -263,6 +263,8 @@ fn issue_14_corpus_meshes_keep_no_small_hinged_piece_and_pass_the_check() {
         let s = corpus::asset(name).unwrap();
         let (m, r) = tetrahedralize(&s, &TetOptions { cell: Some(0.01), ..Default::default() }).unwrap();
         let parts = modal_mesh::face_parts(&m);
+        assert!(parts.hinges.is_empty(), "{name}: hinges left in the output: {:?}", parts.hinges);
+        assert_good(&m, &r);
         for h in &parts.hinges {
             let small = h.parts.map(|p| parts.tets[p]).into_iter().min().unwrap();
             assert!(
