@@ -38,6 +38,8 @@ pub enum Command {
     Strike(StrikeArgs),
     /// Simulate a rigid-body scene and render its sound (no scene: the built-in demo).
     Render(RenderArgs),
+    /// Pressure each audible mode radiates to points around the object, and its radiated power.
+    Radiation(crate::cli::radiation::RadiationArgs),
     /// Reproduce the measurements in BENCHMARKS.md (eigen vs scipy, accuracy vs time, synthesis).
     #[command(subcommand)]
     Bench(crate::cli::bench::BenchCommand),
