@@ -4,10 +4,11 @@
 //! interrupted or failed run never leaves a half-written file.
 //!
 //! Spectrogram: the mean of the channels, Hann windows of [`SPECTROGRAM_WINDOW`]
-//! samples, time along x (columns merge frames by their maximum), frequency
-//! 0 .. fs/2 linearly along y (low at the bottom), magnitude in dB over the
-//! top [`SPECTROGRAM_RANGE_DB`] below the loudest bin, dark → bright. No text
-//! is drawn, so no font is needed.
+//! samples, hop a quarter window; time [s] along x (a pixel column shows the
+//! loudest of the frames it covers), frequency 0 .. fs/2 [kHz] linearly along
+//! y (low at the bottom), level in dB relative to the loudest bin over the top
+//! [`SPECTROGRAM_RANGE_DB`], dark → bright, explained by a colour bar. Axes,
+//! ticks, units and labels use the embedded font of `modal-plot`.
 
 use std::io::Write;
 use std::path::Path;
@@ -23,7 +24,9 @@ use crate::{Rendered, SceneError};
 pub const SPECTROGRAM_WINDOW: usize = 1024;
 /// Dynamic range shown by the spectrogram [dB].
 pub const SPECTROGRAM_RANGE_DB: f64 = 100.0;
-const SPECTROGRAM_SIZE: (u32, u32) = (1000, 512);
+const SPECTROGRAM_SIZE: (u32, u32) = (1100, 560);
+/// Width of the colour-bar strip at the right [px].
+const COLORBAR_WIDTH: u32 = 110;
 
 fn io_error(path: &Path, e: impl std::fmt::Display) -> SceneError {
     SceneError::Io { path: path.to_path_buf(), message: e.to_string() }
@@ -89,48 +92,77 @@ fn stft_db(channels: &[Vec<f32>]) -> Vec<Vec<f64>> {
     frames
 }
 
-/// A dark-blue → magenta → yellow ramp for `x` in [0, 1].
-fn color(x: f64) -> RGBColor {
-    let x = x.clamp(0.0, 1.0);
-    let r = (255.0 * (1.5 * x).min(1.0)) as u8;
-    let g = (255.0 * (2.0 * x - 1.0).clamp(0.0, 1.0)) as u8;
-    let b = (255.0 * (0.35 + 0.65 * (1.0 - (2.0 * x - 0.6).abs()).clamp(0.0, 1.0)) * (1.0 - x * x)) as u8;
-    RGBColor(r, g, b)
-}
-
-/// Draws a spectrogram of the channels as a PNG image.
-pub fn write_spectrogram_png(channels: &[Vec<f32>], path: &Path) -> Result<(), SceneError> {
+/// Draws a spectrogram of the channels, sampled at `sample_rate` Hz, as a PNG image.
+pub fn write_spectrogram_png(channels: &[Vec<f32>], sample_rate: u32, path: &Path) -> Result<(), SceneError> {
     let dir = parent_dir(path)?;
     let frames = stft_db(channels);
     let top = frames.iter().flatten().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let (width, height) = SPECTROGRAM_SIZE;
-    let bins = SPECTROGRAM_WINDOW / 2 + 1;
     let mut builder = tempfile::Builder::new();
     builder.prefix(".modal-spectrogram-").suffix(".png");
     // Like a plain `File::create` (0o666 minus the umask), not 0o600.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
     let tmp = builder.tempfile_in(dir).map_err(|e| io_error(path, e))?;
-    {
-        let root = BitMapBackend::new(tmp.path(), (width, height)).into_drawing_area();
-        for x in 0..width {
-            let f0 = x as usize * frames.len() / width as usize;
-            let f1 = ((x as usize + 1) * frames.len() / width as usize).max(f0 + 1).min(frames.len());
-            for y in 0..height {
-                let b0 = (height - 1 - y) as usize * bins / height as usize;
-                let b1 = ((height - y) as usize * bins / height as usize).max(b0 + 1).min(bins);
-                let mut v = f64::NEG_INFINITY;
-                for frame in frames.get(f0..f1).unwrap_or(&[]) {
-                    for m in &frame[b0..b1] {
-                        v = v.max(*m);
-                    }
-                }
-                let level = 1.0 - (top - v) / SPECTROGRAM_RANGE_DB;
-                root.draw_pixel((x as i32, y as i32), &color(level)).map_err(|e| io_error(path, e))?;
-            }
-        }
-        root.present().map_err(|e| io_error(path, e))?;
-    }
+    let samples = channels.first().map_or(0, Vec::len);
+    let fs = f64::from(sample_rate.max(1));
+    let axes = SpectrogramAxes { seconds: (samples as f64 / fs).max(1.0 / fs), nyquist_khz: fs / 2000.0 };
+    draw_spectrogram(tmp.path(), &frames, top, axes).map_err(|e| io_error(path, e))?;
     tmp.persist(path).map_err(|e| io_error(path, e.error))?;
     Ok(())
+}
+
+/// Extent of the spectrogram's axes.
+#[derive(Clone, Copy)]
+struct SpectrogramAxes {
+    seconds: f64,
+    nyquist_khz: f64,
+}
+
+fn draw_spectrogram(png: &Path, frames: &[Vec<f64>], top: f64, axes: SpectrogramAxes) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<_>| e.to_string();
+    let root = BitMapBackend::new(png, SPECTROGRAM_SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let (main, bar) = root.split_horizontally(SPECTROGRAM_SIZE.0 - COLORBAR_WIDTH);
+    let mut chart = ChartBuilder::on(&main)
+        .caption("Spectrogram", modal_plot::font(22))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..axes.seconds, 0.0..axes.nyquist_khz)
+        .map_err(e)?;
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let (width, height) = (xs.len(), ys.len());
+    let bins = SPECTROGRAM_WINDOW / 2 + 1;
+    for x in 0..width {
+        let f0 = x * frames.len() / width;
+        let f1 = ((x + 1) * frames.len() / width).max(f0 + 1).min(frames.len());
+        for y in 0..height {
+            let b0 = (height - 1 - y) * bins / height;
+            let b1 = ((height - y) * bins / height).max(b0 + 1).min(bins);
+            let mut v = f64::NEG_INFINITY;
+            for frame in frames.get(f0..f1).unwrap_or(&[]) {
+                for m in &frame[b0..b1] {
+                    v = v.max(*m);
+                }
+            }
+            let level = 1.0 - (top - v) / SPECTROGRAM_RANGE_DB;
+            let pixel = (xs.start + x as i32, ys.start + y as i32);
+            root.draw_pixel(pixel, &modal_plot::heat(level)).map_err(e)?;
+        }
+    }
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_label_formatter(&|t| format!("{}", (t * 1e6).round() / 1e6))
+        .y_label_formatter(&|f| format!("{}", (f * 1e6).round() / 1e6))
+        .x_desc("time [s]")
+        .y_desc("frequency [kHz]")
+        .label_style(modal_plot::font(15))
+        .axis_desc_style(modal_plot::font(17))
+        .draw()
+        .map_err(e)?;
+    let range = (-SPECTROGRAM_RANGE_DB, 0.0);
+    let rows = (ys.start, ys.end - 1);
+    modal_plot::draw_colorbar(&bar, range, 20.0, rows, "level [dB re. loudest]").map_err(e)?;
+    root.present().map_err(e)
 }
