@@ -106,7 +106,9 @@ pub fn write_spectrogram_png(channels: &[Vec<f32>], sample_rate: u32, path: &Pat
     let samples = channels.first().map_or(0, Vec::len);
     let fs = f64::from(sample_rate.max(1));
     let axes = SpectrogramAxes { seconds: (samples as f64 / fs).max(1.0 / fs), nyquist_khz: fs / 2000.0 };
-    draw_spectrogram(tmp.path(), &frames, top, axes).map_err(|e| io_error(path, e))?;
+    let root = BitMapBackend::new(tmp.path(), SPECTROGRAM_SIZE).into_drawing_area();
+    draw_spectrogram(&root, &frames, top, axes).map_err(|e| io_error(path, e))?;
+    drop(root);
     tmp.persist(path).map_err(|e| io_error(path, e.error))?;
     Ok(())
 }
@@ -118,20 +120,21 @@ struct SpectrogramAxes {
     nyquist_khz: f64,
 }
 
-fn draw_spectrogram(png: &Path, frames: &[Vec<f64>], top: f64, axes: SpectrogramAxes) -> Result<(), String> {
-    let e = |e: DrawingAreaErrorKind<_>| e.to_string();
-    let root = BitMapBackend::new(png, SPECTROGRAM_SIZE).into_drawing_area();
+/// Plot frame inside the image, pixels: left, top, right, bottom.
+const SPECTROGRAM_FRAME: (i32, i32, i32, i32) =
+    (84, 44, SPECTROGRAM_SIZE.0 as i32 - COLORBAR_WIDTH as i32 - 14, 496);
+
+fn draw_spectrogram<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    frames: &[Vec<f64>],
+    top: f64,
+    axes: SpectrogramAxes,
+) -> Result<(), String> {
+    use modal_plot::{draw_text, nice_ticks, HPos, Text, VPos};
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
-    let (main, bar) = root.split_horizontally(SPECTROGRAM_SIZE.0 - COLORBAR_WIDTH);
-    let mut chart = ChartBuilder::on(&main)
-        .caption("Spectrogram", modal_plot::font(22))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
-        .build_cartesian_2d(0.0..axes.seconds, 0.0..axes.nyquist_khz)
-        .map_err(e)?;
-    let (xs, ys) = chart.plotting_area().get_pixel_range();
-    let (width, height) = (xs.len(), ys.len());
+    let (l, t, r, b) = SPECTROGRAM_FRAME;
+    let (width, height) = ((r - l) as usize, (b - t) as usize);
     let bins = SPECTROGRAM_WINDOW / 2 + 1;
     for x in 0..width {
         let f0 = x * frames.len() / width;
@@ -146,23 +149,82 @@ fn draw_spectrogram(png: &Path, frames: &[Vec<f64>], top: f64, axes: Spectrogram
                 }
             }
             let level = 1.0 - (top - v) / SPECTROGRAM_RANGE_DB;
-            let pixel = (xs.start + x as i32, ys.start + y as i32);
-            root.draw_pixel(pixel, &modal_plot::heat(level)).map_err(e)?;
+            root.draw_pixel((l + x as i32, t + y as i32), &modal_plot::heat(level)).map_err(e)?;
         }
     }
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_label_formatter(&|t| format!("{}", (t * 1e6).round() / 1e6))
-        .y_label_formatter(&|f| format!("{}", (f * 1e6).round() / 1e6))
-        .x_desc("time [s]")
-        .y_desc("frequency [kHz]")
-        .label_style(modal_plot::font(15))
-        .axis_desc_style(modal_plot::font(17))
-        .draw()
-        .map_err(e)?;
+    root.draw(&Rectangle::new([(l, t), (r, b)], BLACK.stroke_width(1))).map_err(e)?;
+    let tick = Text::new(15.0);
+    for s in nice_ticks(0.0, axes.seconds, 10) {
+        let x = l + (s / axes.seconds * (r - l) as f64).round() as i32;
+        root.draw(&PathElement::new(vec![(x, b), (x, b + 6)], BLACK)).map_err(e)?;
+        draw_text(root, &format!("{s}"), (x, b + 9), &tick.at(HPos::Center, VPos::Top)).map_err(e)?;
+    }
+    for f in nice_ticks(0.0, axes.nyquist_khz, 8) {
+        let y = b - (f / axes.nyquist_khz * (b - t) as f64).round() as i32;
+        root.draw(&PathElement::new(vec![(l - 6, y), (l, y)], BLACK)).map_err(e)?;
+        draw_text(root, &format!("{f}"), (l - 9, y), &tick.at(HPos::Right, VPos::Center)).map_err(e)?;
+    }
+    let label = Text::new(17.0);
+    draw_text(root, "time [s]", ((l + r) / 2, b + 32), &label.at(HPos::Center, VPos::Top)).map_err(e)?;
+    let up = label.at(HPos::Center, VPos::Top).upwards();
+    draw_text(root, "frequency [kHz]", (14, (t + b) / 2), &up).map_err(e)?;
+    let title = Text::new(21.0).at(HPos::Center, VPos::Bottom);
+    draw_text(root, "Spectrogram (mean of the channels)", ((l + r) / 2, t - 12), &title).map_err(e)?;
+    let (bar_x, bar_w) = (SPECTROGRAM_SIZE.0 - COLORBAR_WIDTH, COLORBAR_WIDTH);
+    let bar = root.clone().shrink((bar_x, 0), (bar_w, SPECTROGRAM_SIZE.1));
     let range = (-SPECTROGRAM_RANGE_DB, 0.0);
-    let rows = (ys.start, ys.end - 1);
-    modal_plot::draw_colorbar(&bar, range, 20.0, rows, "level [dB re. loudest]").map_err(e)?;
+    modal_plot::draw_colorbar(&bar, range, 20.0, (t, b), "level [dB re. loudest bin]").map_err(e)?;
     root.present().map_err(e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tone_is_drawn_at_its_frequency_and_the_axes_are_labelled() {
+        // 1 s of a 3 kHz tone at 16 kHz: Nyquist 8 kHz, so the tone sits 3/8 up the frame.
+        let fs = 16_000u32;
+        let tone: Vec<f32> = (0..fs)
+            .map(|i| (2.0 * std::f64::consts::PI * 3000.0 * i as f64 / fs as f64).sin() as f32)
+            .collect();
+        let frames = stft_db(&[tone]);
+        let top = frames.iter().flatten().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let (w, h) = (SPECTROGRAM_SIZE.0 as usize, SPECTROGRAM_SIZE.1 as usize);
+        let mut pixels = vec![0u8; w * h * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut pixels, SPECTROGRAM_SIZE).into_drawing_area();
+            let axes = SpectrogramAxes { seconds: 1.0, nyquist_khz: 8.0 };
+            draw_spectrogram(&root, &frames, top, axes).unwrap();
+            root.present().unwrap();
+        }
+        let px = |x: i32, y: i32| {
+            let i = (y as usize * w + x as usize) * 3;
+            [pixels[i], pixels[i + 1], pixels[i + 2]]
+        };
+        let (l, t, r, b) = SPECTROGRAM_FRAME;
+        // The brightest row of the middle column is the tone's.
+        let x = (l + r) / 2;
+        let luma = |p: [u8; 3]| p[0] as u32 * 3 + p[1] as u32 * 6 + p[2] as u32;
+        let brightest = (t + 1..b).max_by_key(|&y| luma(px(x, y))).unwrap();
+        let expected = b as f64 - 3.0 / 8.0 * (b - t) as f64;
+        assert!((brightest as f64 - expected).abs() <= 2.0, "tone at row {brightest}, expected {expected}");
+        assert_eq!(px(x, brightest), [255, 255, 0], "the loudest bin is the top of the colour map");
+        // Text in the margins (tick labels and axis titles) is dark on white.
+        let dark = |x0: i32, x1: i32, y0: i32, y1: i32| {
+            (x0..x1)
+                .flat_map(|x| (y0..y1).map(move |y| (x, y)))
+                .filter(|&(x, y)| luma(px(x, y)) < 500)
+                .count()
+        };
+        assert!(dark(0, l - 2, t, b) > 200, "frequency ticks and label");
+        assert!(dark(l, r, b + 2, h as i32) > 200, "time ticks and label");
+        assert!(dark(0, w as i32, 0, t - 2) > 100, "title");
+        let ramp_end = (SPECTROGRAM_SIZE.0 - COLORBAR_WIDTH) as i32 + 6 + 22;
+        assert!(dark(ramp_end + 6, w as i32, t, b) > 200, "colour bar tick labels and title");
+        // The ramp itself: dark at the bottom, yellow at the top.
+        let top_of_ramp = px(ramp_end - 5, t + 1);
+        assert!(top_of_ramp[0] == 255 && top_of_ramp[1] > 240 && top_of_ramp[2] < 10, "{top_of_ramp:?}");
+        assert!(luma(px(ramp_end - 5, b - 1)) < 300);
+    }
 }

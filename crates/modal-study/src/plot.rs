@@ -8,9 +8,8 @@
 //! place on a log axis). The file is written to a temporary name in the same
 //! directory and renamed, so a reader never sees a partial PNG.
 
-use modal_plot::font;
+use modal_plot::{draw_text, HPos, Text, VPos};
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::{Path, PathBuf};
 
 /// One curve: a label for the legend and its (x, y) points, both > 0.
@@ -67,9 +66,9 @@ const SIZE: (u32, u32) = (960, 640);
 /// Plot frame in pixels: left, top, right, bottom.
 const FRAME: (i32, i32, i32, i32) = (110, 60, 700, 560);
 /// Text sizes [px]: title, axis labels, tick labels and legend.
-const TITLE: u32 = 22;
-const LABEL: u32 = 18;
-const TICK: u32 = 16;
+const TITLE: f32 = 22.0;
+const LABEL: f32 = 18.0;
+const TICK: f32 = 16.0;
 /// Legend line spacing [px].
 const LINE: i32 = 26;
 /// Line colours of successive series.
@@ -182,7 +181,7 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
         let (x, _) = axes.px(10f64.powi(k), 1.0);
         area.draw(&PathElement::new(vec![(x, t), (x, b)], GRID))?;
         area.draw(&PathElement::new(vec![(x, b), (x, b + 8)], BLACK))?;
-        area.draw_text(&decade_label(k), &font(TICK).pos(Pos::new(HPos::Center, VPos::Top)), (x, b + 12))?;
+        draw_text(area, &decade_label(k), (x, b + 12), &Text::new(TICK).at(HPos::Center, VPos::Top))?;
         for m in 2..10 {
             let (xm, _) = axes.px(m as f64 * 10f64.powi(k), 1.0);
             if k < axes.xs.1 {
@@ -194,7 +193,7 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
         let (_, y) = axes.px(1.0, 10f64.powi(k));
         area.draw(&PathElement::new(vec![(l, y), (r, y)], GRID))?;
         area.draw(&PathElement::new(vec![(l - 8, y), (l, y)], BLACK))?;
-        area.draw_text(&decade_label(k), &font(TICK).pos(Pos::new(HPos::Right, VPos::Center)), (l - 12, y))?;
+        draw_text(area, &decade_label(k), (l - 12, y), &Text::new(TICK).at(HPos::Right, VPos::Center))?;
         for m in 2..10 {
             let (_, ym) = axes.px(1.0, m as f64 * 10f64.powi(k));
             if k < axes.ys.1 {
@@ -207,11 +206,9 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
 
 fn draw_labels(area: &Area, plot: &LogLogPlot, _axes: &Axes) -> DrawResult {
     let (l, t, r, b) = FRAME;
-    let centered = |size: u32, v: VPos| font(size).pos(Pos::new(HPos::Center, v));
-    area.draw_text(plot.title, &centered(TITLE, VPos::Bottom), ((l + r) / 2, t - 18))?;
-    area.draw_text(plot.x_label, &centered(LABEL, VPos::Top), ((l + r) / 2, b + 42))?;
-    let up = font(LABEL).transform(FontTransform::Rotate270).pos(Pos::new(HPos::Center, VPos::Top));
-    area.draw_text(plot.y_label, &up, (14, (t + b) / 2))
+    draw_text(area, plot.title, ((l + r) / 2, t - 18), &Text::new(TITLE).at(HPos::Center, VPos::Bottom))?;
+    draw_text(area, plot.x_label, ((l + r) / 2, b + 42), &Text::new(LABEL).at(HPos::Center, VPos::Top))?;
+    draw_text(area, plot.y_label, (14, (t + b) / 2), &Text::new(LABEL).at(HPos::Center, VPos::Top).upwards())
 }
 
 fn draw_series(area: &Area, axes: &Axes, series: &Series, color: &RGBColor) -> DrawResult {
@@ -232,7 +229,7 @@ fn draw_legend(area: &Area, series: &[Series]) -> DrawResult {
         let color = PALETTE[i % PALETTE.len()];
         area.draw(&PathElement::new(vec![(r + 16, mid), (r + 46, mid)], color.stroke_width(2)))?;
         area.draw(&Circle::new((r + 31, mid), 4, color.filled()))?;
-        area.draw_text(&s.label, &font(TICK).pos(Pos::new(HPos::Left, VPos::Center)), (r + 54, mid))?;
+        draw_text(area, &s.label, (r + 54, mid), &Text::new(TICK).at(HPos::Left, VPos::Center))?;
     }
     Ok(())
 }
