@@ -131,7 +131,7 @@ pub fn draw_text<DB: DrawingBackend>(
 /// of them (at least 2 when `hi > lo`); values are rounded to the step's
 /// decimals so they print cleanly.
 pub fn nice_ticks(lo: f64, hi: f64, max_ticks: usize) -> Vec<f64> {
-    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
+    if hi <= lo || lo.is_nan() || hi.is_nan() || !lo.is_finite() || !hi.is_finite() {
         return vec![lo];
     }
     let raw = (hi - lo) / max_ticks.max(2) as f64;
