@@ -237,7 +237,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
     }
     if let Some(path) = &args.events {
-        interrupt::guarded(|| modal_scene::write_events_json(&rendered.events, path))?;
+        interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))?;
     }
     if let Some(path) = &args.spectrogram {
         interrupt::guarded(|| {
