@@ -47,21 +47,22 @@ material = "brass"
 TOML
 echo "assets: $(ls props | wc -l)"
 # Wall time of a command [s] (its stdout discarded).
-t() { local start end; start=$(date +%s.%N); "$@" >/dev/null; end=$(date +%s.%N); echo "$end - $start" | bc -l; }
+# Wall time of a command [s] (its output to batch.log).
+t() { local start end; start=$(date +%s.%N); "$@" >>batch.log 2>&1; end=$(date +%s.%N); echo "$end - $start" | bc -l; }
 echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 
-rm -rf one jobs2 two rerun rerun2 cache-one cache-jobs2 cache-two
+rm -rf one jobs2 two rerun rerun2 cache-one cache-jobs2 cache-two batch.log
 echo "one shard (one process): $(t "$MODAL" precompute-batch library.toml --out one --cache-dir cache-one --json) s"
 echo "one process, --jobs 2: $(t "$MODAL" precompute-batch library.toml --out jobs2 --cache-dir cache-jobs2 --jobs 2 --json) s"
 start=$(date +%s.%N)
-"$MODAL" precompute-batch library.toml --out two --cache-dir cache-two --shard 0/2 --json >shard0.json &
+"$MODAL" precompute-batch library.toml --out two --cache-dir cache-two --shard 0/2 --json >shard0.json 2>>batch.log &
 p0=$!
-"$MODAL" precompute-batch library.toml --out two --cache-dir cache-two --shard 1/2 --json >shard1.json &
+"$MODAL" precompute-batch library.toml --out two --cache-dir cache-two --shard 1/2 --json >shard1.json 2>>batch.log &
 p1=$!
 wait $p0 $p1
 end=$(date +%s.%N)
 echo "two shards (two processes at once): $(echo "$end - $start" | bc -l) s ($(grep -h '"total"' shard0.json shard1.json | tr -d ' ,\n'))"
 "$MODAL" catalogue merge two -o two/catalogue.json
 echo "cache-hit re-run (one process): $(t "$MODAL" precompute-batch library.toml --out rerun --cache-dir cache-one --json) s"
-"$MODAL" precompute-batch library.toml --out rerun2 --cache-dir cache-one --json | grep -E '"(computed|cached)"' | tr -d ' ,\n'; echo
+"$MODAL" precompute-batch library.toml --out rerun2 --cache-dir cache-one --json 2>>batch.log | grep -E '^  "(computed|cached)"' | tr -d ' ,\n'; echo
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
