@@ -158,3 +158,71 @@ fn faust_export_refuses_bad_input_and_leaves_nothing() {
     // No output format at all.
     assert_eq!(modal(dir.path(), &["export", "bar.bank"]).code, Some(2));
 }
+
+#[test]
+fn gltf_export_round_trips_to_identical_wavs_and_banks() {
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let report = modal(dir.path(), &["export", "bar.bank", "--gltf", "bar.glb", "--json"]).ok().json();
+    assert!(report["gltf"]["bytes"].as_u64().unwrap() > 1000);
+    let glb = std::fs::read(dir.path().join("bar.glb")).unwrap();
+    assert_eq!(&glb[..4], b"glTF");
+    // Strike the bank and the glTF the same way: the same samples.
+    let strike = |bank: &str, out: &str| {
+        let args = [
+            "strike",
+            bank,
+            "--at",
+            "0.05,0.01,0.01",
+            "--at",
+            "0.29,0.0,0.005",
+            "--duration",
+            "0.3",
+            "-o",
+            out,
+        ];
+        modal(dir.path(), &args).ok();
+        std::fs::read(dir.path().join(out)).unwrap()
+    };
+    let from_bank = strike("bar.bank", "bank.wav");
+    let from_gltf = strike("bar.glb", "gltf.wav");
+    assert!(from_bank.len() > 10_000);
+    assert_eq!(from_bank, from_gltf, "identical WAV bytes");
+    // precompute on a glTF stores its modes: the same bank file, byte for byte.
+    let json = modal(dir.path(), &["precompute", "bar.glb", "-o", "again.bank", "--json"]).ok().json();
+    assert_eq!(json["modes"].as_array().unwrap().len(), 12);
+    let original = std::fs::read(dir.path().join("bar.bank")).unwrap();
+    assert_eq!(std::fs::read(dir.path().join("again.bank")).unwrap(), original);
+    // info reads it too.
+    let info = modal(dir.path(), &["info", "bar.glb", "--json"]).ok().json();
+    assert_eq!(info["modes"], json["modes"]);
+}
+
+#[test]
+fn a_scene_object_can_name_a_gltf_bank() {
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    modal(dir.path(), &["export", "bar.bank", "--gltf", "bar.glb"]).ok();
+    let scene = |bank: &str| {
+        format!(
+            "duration = 0.4\nsample_rate = 16000\n[listener]\nposition = [0.0, 0.2, 0.5]\nchannels = \"mono\"\n\
+             [ground]\nmaterial = \"wood\"\n[[objects]]\nname = \"bar\"\nbank = \"{bank}\"\nposition = [0.0, 0.05, 0.0]\n"
+        )
+    };
+    std::fs::write(dir.path().join("a.toml"), scene("bar.bank")).unwrap();
+    std::fs::write(dir.path().join("b.toml"), scene("bar.glb")).unwrap();
+    let a = modal(dir.path(), &["render", "a.toml", "-o", "a.wav", "--json"]).ok().json();
+    modal(dir.path(), &["render", "b.toml", "-o", "b.wav"]).ok();
+    assert!(a["objects"][0]["impacts"].as_u64().unwrap() >= 1, "{a}");
+    let wav = std::fs::read(dir.path().join("a.wav")).unwrap();
+    assert_eq!(std::fs::read(dir.path().join("b.wav")).unwrap(), wav);
+}
+
+#[test]
+fn gltf_files_without_modal_data_are_refused() {
+    let dir = temp_dir();
+    std::fs::write(dir.path().join("junk.glb"), b"glTF but not really").unwrap();
+    modal(dir.path(), &["strike", "junk.glb", "--at", "0,0,0", "-o", "x.wav"]).fails_with("junk.glb");
+    modal(dir.path(), &["precompute", "junk.glb", "-o", "x.bank"]).fails_with("not a valid glTF");
+    assert!(!dir.path().join("x.wav").exists() && !dir.path().join("x.bank").exists());
+}

@@ -38,6 +38,8 @@ pub enum Command {
     Strike(StrikeArgs),
     /// Simulate a rigid-body scene and render its sound (no scene: the built-in demo).
     Render(RenderArgs),
+    /// Pressure each audible mode radiates to points around the object, and its radiated power.
+    Radiation(crate::cli::radiation::RadiationArgs),
     /// Reproduce the measurements in BENCHMARKS.md (eigen vs scipy, accuracy vs time, synthesis).
     #[command(subcommand)]
     Bench(crate::cli::bench::BenchCommand),
@@ -143,6 +145,8 @@ pub enum MeshShape {
         #[command(flatten)]
         common: GenerateArgs,
     },
+    /// Write the generated corpus of real-world-like surface assets (OBJ).
+    Corpus(crate::cli::corpus::CorpusArgs),
     /// Tetrahedralize a surface mesh (OBJ, STL, PLY).
     Tet {
         /// Surface mesh to fill with tets.
@@ -264,13 +268,16 @@ pub struct RetuneArgs {
 }
 
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["vtk", "faust"])))]
+#[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["vtk", "faust", "gltf"])))]
 pub struct ExportArgs {
-    /// Mode bank.
+    /// Mode bank (or a glTF with a modal model).
     pub bank: PathBuf,
     /// VTK XML unstructured grid to write (ParaView).
     #[arg(long, value_name = "OUT.vtu")]
     pub vtk: Option<PathBuf>,
+    /// Binary glTF to write: the surface mesh with the modes in the KHR_audio_rigid_bodies extension.
+    #[arg(long, value_name = "OUT.glb")]
+    pub gltf: Option<PathBuf>,
     /// Faust library to write: a mesh2faust-style modal model excited at the --at points.
     #[arg(long, value_name = "OUT.lib", requires = "at")]
     pub faust: Option<PathBuf>,

@@ -8,8 +8,15 @@ use super::bank_report::BankJson;
 use super::interrupt;
 use super::output::print_json;
 
-/// Loads a bank, naming the file in the error.
+/// Loads a bank, naming the file in the error. A `.glb`/`.gltf` file is read
+/// as the bank of its modal model (KHR_audio_rigid_bodies), warnings on stderr.
 pub fn load_bank(path: &std::path::Path) -> Result<ModeBank> {
+    if modal_export::gltf::is_gltf_path(path) {
+        let imported = modal_export::gltf::import_gltf_file(path)
+            .with_context(|| format!("cannot load bank {}", path.display()))?;
+        imported.warnings.iter().for_each(|w| super::output::warn(&format!("{}: {w}", path.display())));
+        return Ok(imported.bank);
+    }
     ModeBank::load(path).with_context(|| format!("cannot load bank {}", path.display()))
 }
 

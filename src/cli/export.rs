@@ -1,5 +1,5 @@
-//! `modal export`: a bank out to other tools — ParaView (`--vtk`) and Faust
-//! (`--faust` with `--at`). Every file is written atomically; with several
+//! `modal export`: a bank out to other tools — ParaView (`--vtk`), glTF
+//! (`--gltf`, docs/gltf-extension.md) and Faust (`--faust` with `--at`). Every file is written atomically; with several
 //! formats, each is written in turn and the summary lists what was written.
 
 use std::io::Write;
@@ -83,12 +83,30 @@ fn faust(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
     }))
 }
 
+fn gltf(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
+    let name = args.bank.file_stem().map_or_else(|| "model".into(), |n| n.to_string_lossy().into_owned());
+    let bytes = modal_export::gltf::export_glb(bank, &name, true).context("--gltf")?;
+    write_file(path, |w| Ok(w.write_all(&bytes)?))?;
+    let line = format!(
+        "wrote {} (glTF, {}: {} modes on {} surface points, {} bytes)",
+        path.display(),
+        modal_export::gltf::EXTENSION,
+        bank.mode_count(),
+        bank.surface_node_count(),
+        bytes.len()
+    );
+    Ok(json!({ "path": path.display().to_string(), "bytes": bytes.len(), "summary": line }))
+}
+
 pub fn run(args: ExportArgs) -> Result<()> {
     let bank = load_bank(&args.bank)?;
     let mut report = serde_json::Map::new();
     report.insert("bank".into(), json!(args.bank.display().to_string()));
     if let Some(path) = &args.vtk {
         report.insert("vtk".into(), vtk(&bank, path)?);
+    }
+    if let Some(path) = &args.gltf {
+        report.insert("gltf".into(), gltf(&bank, &args, path)?);
     }
     if let Some(path) = &args.faust {
         report.insert("faust".into(), faust(&bank, &args, path)?);

@@ -19,6 +19,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
         }
         MeshShape::Sphere { radius, common } => generate(Shape::Sphere { radius }, common),
         MeshShape::Bowl { radius, thickness, common } => generate(Shape::Bowl { radius, thickness }, common),
+        MeshShape::Corpus(args) => super::corpus::run(args),
         MeshShape::Tet { input, out, cell, scale, part, json } => {
             let (surface, report) = modal_tetra::read_surface(&input, scale, part.as_deref())
                 .with_context(|| format!("cannot read surface mesh {}", input.display()))?;

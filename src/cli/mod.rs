@@ -8,6 +8,7 @@ mod bank_report;
 mod batch;
 mod bench;
 mod catalogue;
+mod corpus;
 mod export;
 mod interrupt;
 mod material;
@@ -15,6 +16,7 @@ mod mesh;
 mod output;
 mod precompute;
 mod progress;
+mod radiation;
 mod render;
 mod strike;
 
@@ -56,6 +58,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Strike(args)) => strike::run(args),
         Some(Command::Render(args)) => render::run(args),
         Some(Command::Bench(command)) => bench::run(command),
+        Some(Command::Radiation(args)) => radiation::run(args),
     }
 }
 

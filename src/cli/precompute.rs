@@ -43,6 +43,9 @@ pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Option<BankCache> {
 }
 
 pub fn run(args: PrecomputeArgs) -> Result<()> {
+    if modal_export::gltf::is_gltf_path(&args.mesh) {
+        return import_gltf(&args);
+    }
     let mut request = request(&args.mesh, &args.material, &args.input)?;
     request.max_modes = args.modes;
     request.min_freq_hz = args.min_freq;
@@ -112,6 +115,27 @@ pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
             assembled.mesh.cells.len(),
             assembled.mesh.order()
         );
+        Ok(())
+    }
+}
+
+/// `modal precompute MODEL.glb -o X.bank`: a glTF with a modal model is an
+/// existing bank; it is read and stored, nothing is solved.
+fn import_gltf(args: &PrecomputeArgs) -> Result<()> {
+    let m = &args.material;
+    let flags = [m.material.is_some(), m.youngs.is_some(), m.poisson.is_some(), m.density.is_some()];
+    if flags.into_iter().any(|given| given) || m.alpha.is_some() || m.beta.is_some() {
+        warn("the glTF already holds modes: material flags are ignored (use `modal retune` to change them)");
+    }
+    let bank = super::bank_cmds::load_bank(&args.mesh)?;
+    interrupt::guarded(|| bank.save(&args.out))
+        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    let report = BankJson::new(&bank, false);
+    if args.json {
+        print_json(&report)
+    } else {
+        report.write_table(&mut std::io::stdout().lock())?;
+        println!("wrote {} (modes read from {}, no solve)", args.out.display(), args.mesh.display());
         Ok(())
     }
 }

@@ -42,6 +42,11 @@ struct PipelineProvider<'a> {
 impl BankProvider for PipelineProvider<'_> {
     fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError> {
         if let Some(path) = &request.bank {
+            if modal_export::gltf::is_gltf_path(path) {
+                let imported = modal_export::gltf::import_gltf_file(path)?;
+                self.warnings.extend(imported.warnings.iter().map(|w| format!("{}: {w}", path.display())));
+                return Ok(Arc::new(imported.bank));
+            }
             return Ok(Arc::new(ModeBank::load(path)?));
         }
         let mesh = request.mesh.as_ref().ok_or("the object names neither a mesh nor a bank")?;
@@ -232,7 +237,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
     }
     if let Some(path) = &args.events {
-        interrupt::guarded(|| modal_scene::write_events_json(&rendered.events, path))?;
+        interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))?;
     }
     if let Some(path) = &args.spectrogram {
         interrupt::guarded(|| modal_scene::write_spectrogram_png(&rendered.channels, path))?;

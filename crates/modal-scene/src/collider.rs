@@ -21,6 +21,12 @@
 //!   mesh's (mass / density) by more than
 //!   [`crate::AUTO_DECOMPOSITION_RATIO`], else the hull.
 //!
+//! - a dynamic body whose surface nodes all lie on one sphere (within
+//!   [`SPHERE_TOLERANCE`] of its radius), with `collider = "hull"` or
+//!   `"auto"`: an exact ball. A faceted hull rolls on its facet edges and hops
+//!   (a 2 cm ball at 0.5 m/s left the floor every ≈ 0.1 s), which is heard as
+//!   ticks when it should roll smoothly (issue #16).
+//!
 //! A decomposition costs set-up time (measured in `docs/benchmarks/scene.md`),
 //! so it is computed once per distinct bank and shared by its instances
 //! ([`ShapeCache`]).
@@ -36,6 +42,10 @@ use crate::SceneError;
 
 /// Most vertices kept in a dynamic body's convex hull.
 pub const MAX_HULL_VERTICES: usize = 384;
+
+/// A surface is a sphere when every node's distance from the nodes' bounding
+/// box centre is within this fraction of the mean distance.
+pub const SPHERE_TOLERANCE: f64 = 1e-3;
 
 /// Voxels along the longest extent of a decomposed surface.
 pub const DECOMPOSITION_RESOLUTION: u32 = 64;
@@ -67,7 +77,16 @@ impl ShapeCache {
                 message: "degenerate convex hull".into(),
             })
         };
+        let sphere = match kind {
+            ColliderKind::Hull | ColliderKind::Auto => sphere_of(bank),
+            ColliderKind::Decomposition => None,
+        };
         let shape = match kind {
+            _ if sphere.is_some() => {
+                let (c, r) = sphere.unwrap_or_default();
+                let at = Pose::from_translation(Vector::new(c[0] as f32, c[1] as f32, c[2] as f32));
+                SharedShape::compound(vec![(at, SharedShape::ball(r as f32))])
+            }
             ColliderKind::Hull => hull()?,
             ColliderKind::Decomposition => decomposition(bank, &points, path)?,
             ColliderKind::Auto => {
@@ -84,6 +103,28 @@ impl ShapeCache {
         self.shapes.push((key, kind, shape.clone()));
         Ok(shape)
     }
+}
+
+/// Centre and radius of the sphere every surface node lies on (module doc),
+/// if there is one.
+fn sphere_of(bank: &ModeBank) -> Option<([f64; 3], f64)> {
+    let p = &bank.surface.positions;
+    if p.len() < 12 {
+        return None;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in p {
+        for c in 0..3 {
+            lo[c] = lo[c].min(x[c]);
+            hi[c] = hi[c].max(x[c]);
+        }
+    }
+    let centre: [f64; 3] = std::array::from_fn(|c| 0.5 * (lo[c] + hi[c]));
+    let dist = |x: &[f64; 3]| (0..3).map(|c| (x[c] - centre[c]).powi(2)).sum::<f64>().sqrt();
+    let mean = p.iter().map(dist).sum::<f64>() / p.len() as f64;
+    let round = mean > 0.0 && p.iter().all(|x| (dist(x) - mean).abs() <= SPHERE_TOLERANCE * mean);
+    round.then_some((centre, mean))
 }
 
 /// The surface nodes as rapier vectors (mesh frame).

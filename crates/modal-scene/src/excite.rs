@@ -217,7 +217,14 @@ mod tests {
     use super::*;
 
     fn side(mass: f64, radius: f64, e: f64) -> ContactSide {
-        ContactSide { object: None, plane_strain_pa: e, mass_kg: mass, radius_m: radius }
+        ContactSide {
+            object: None,
+            plane_strain_pa: e,
+            mass_kg: mass,
+            radius_m: radius,
+            friction: 0.5,
+            finish: crate::roughness::DEFAULT_FINISH,
+        }
     }
 
     /// analytic.md §3: steel ball R = 5 mm (4.110 g) on a massive steel flat

@@ -48,6 +48,7 @@ pub(crate) fn with_slab(scene: &Scene) -> Cow<'_, Scene> {
         restitution: g.restitution,
         contact_radius_m: Some(f64::INFINITY),
         rolling_resistance_m: 0.0,
+        surface: g.surface.clone(),
     };
     let mut rendered = scene.clone();
     rendered.ground = None;

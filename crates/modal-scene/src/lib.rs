@@ -12,7 +12,9 @@
 //! Dynamic bodies collide through a reduced convex hull or, per object, a
 //! convex decomposition (module `collider`); a rolling-resistance couple
 //! lets them come to rest and sleep, after which the physics stops (module
-//! `physics`); the ground is a silent plane or a sounding slab whose bank
+//! `physics`); sliding, scraping and rolling contacts drive both bodies'
+//! modes with a continuous roughness force (module `sustain`, surface
+//! finishes in [`roughness`]); the ground is a silent plane or a sounding slab whose bank
 //! comes from the same provider (module `ground`).
 
 mod collider;
@@ -25,8 +27,10 @@ mod output;
 mod physics;
 mod provider;
 mod render;
+pub mod roughness;
 mod spec;
 pub mod stand_in;
+mod sustain;
 mod validate;
 
 pub use collider::{DECOMPOSITION_CONCAVITY, DECOMPOSITION_RESOLUTION, MAX_HULL_VERTICES};
@@ -52,7 +56,11 @@ pub use render::{
 };
 pub use spec::{
     BodyKind, Channels, ColliderKind, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec,
-    MaterialSpec, MeshSource, ObjectSpec, RotationSpec, Scene, AUTO_DECOMPOSITION_RATIO,
+    MaterialSpec, MeshSource, ObjectSpec, RotationSpec, Scene, SurfaceSpec, AUTO_DECOMPOSITION_RATIO,
     DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
 };
-pub use validate::{MAX_DURATION_S, MAX_OBJECTS, MAX_SLAB_CELLS};
+pub use sustain::{
+    speed_gate, ContactEvent, SustainedEvent, SCRAPE_REFERENCE_SPEED_M_S, SUSTAIN_MIN_SPEED_M_S,
+    SUSTAIN_SMOOTHING_S,
+};
+pub use validate::{MAX_ANGULAR_SPEED_RAD_S, MAX_DURATION_S, MAX_OBJECTS, MAX_SLAB_CELLS, MAX_SPEED_M_S};

@@ -16,7 +16,7 @@ use modal_synth::{WavFormat, WavGain, WavReport};
 use plotters::prelude::*;
 use realfft::RealFftPlanner;
 
-use crate::excite::ImpactEvent;
+use crate::sustain::ContactEvent;
 use crate::{Rendered, SceneError};
 
 /// FFT length of the spectrogram [samples].
@@ -47,8 +47,9 @@ pub fn write_wav(rendered: &Rendered, path: &Path, format: WavFormat) -> Result<
         .map_err(|e| io_error(path, e))
 }
 
-/// Writes the impact events as a JSON array.
-pub fn write_events_json(events: &[ImpactEvent], path: &Path) -> Result<(), SceneError> {
+/// Writes the events (impacts and sustained-contact segments, each tagged
+/// by `"kind"`) as a JSON array.
+pub fn write_events_json(events: &[ContactEvent], path: &Path) -> Result<(), SceneError> {
     let dir = parent_dir(path)?;
     let mut builder = tempfile::Builder::new();
     builder.prefix(".modal-events-").suffix(".tmp");

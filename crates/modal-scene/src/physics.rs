@@ -38,6 +38,7 @@ use rapier3d::prelude::*;
 
 use crate::collider::{surface_points, surface_triangles, ShapeCache};
 use crate::material::{plane_strain_modulus, resolve_material};
+use crate::roughness::{object_surface, resolve_surface, SurfaceFinish};
 use crate::spec::{BodyKind, Scene};
 use crate::SceneError;
 
@@ -65,6 +66,10 @@ pub struct ContactSide {
     pub mass_kg: f64,
     /// Hertz radius of curvature [m]; infinite for the ground.
     pub radius_m: f64,
+    /// Coulomb friction coefficient (a pair uses the mean of both).
+    pub friction: f64,
+    /// Surface finish (sustained contact, [`crate::roughness`]).
+    pub finish: SurfaceFinish,
 }
 
 /// One contact point with a non-zero impulse after a step.
@@ -92,6 +97,8 @@ pub(crate) struct PairContacts {
     pub key: (u32, u32),
     /// Side indices into [`World::sides`].
     pub sides: [usize; 2],
+    /// Unit contact normal from side 1 to side 2, world frame.
+    pub normal: [f64; 3],
     /// Points with an impulse.
     pub points: Vec<ContactPoint>,
 }
@@ -221,11 +228,15 @@ impl World {
                 .restitution_combine_rule(CoefficientCombineRule::Average)
                 .user_data(GROUND);
             world.colliders.insert_with_parent(collider, body, &mut world.bodies);
+            let finish = resolve_surface(g.surface.as_ref(), &g.material)
+                .map_err(|(key, m)| SceneError::invalid(format!("ground.surface.{key}"), m))?;
             sides.push(ContactSide {
                 object: None,
                 plane_strain_pa: plane_strain_modulus(&material),
                 mass_kg: f64::INFINITY,
                 radius_m: f64::INFINITY,
+                friction: g.friction,
+                finish,
             });
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
@@ -311,6 +322,7 @@ impl World {
             };
             let sides = [self.side_of(c1.user_data), self.side_of(c2.user_data)];
             let mut points = Vec::new();
+            let mut normal = [0.0; 3];
             for m in pair.solver_manifolds() {
                 let n = d3(m.data.normal);
                 for p in &m.points {
@@ -324,6 +336,9 @@ impl World {
                     let impulse_on_1 =
                         [-jn * n[0] + friction[0], -jn * n[1] + friction[1], -jn * n[2] + friction[2]];
                     let approach = self.approach_speed(sides, world_m, n, dt);
+                    for c in 0..3 {
+                        normal[c] += jn * n[c];
+                    }
                     points.push(ContactPoint {
                         world_m,
                         local_m: [d3(p.local_p1), d3(p.local_p2)],
@@ -336,7 +351,9 @@ impl World {
             }
             if !points.is_empty() {
                 let key = (pair.collider1.into_raw_parts().0, pair.collider2.into_raw_parts().0);
-                out.push(PairContacts { key, sides, points });
+                let length = dot(normal, normal).sqrt();
+                let normal = if length > 0.0 { normal.map(|x| x / length) } else { [0.0, 1.0, 0.0] };
+                out.push(PairContacts { key, sides, normal, points });
             }
         }
     }
@@ -376,6 +393,14 @@ impl World {
             let couple = (b * jn).min(speed / k);
             body.apply_torque_impulse(v3(axis.map(|x| -couple * x)), false);
         }
+    }
+
+    /// Linear velocity, angular velocity and centre of mass (world frame)
+    /// of a contact side's body now; `None` for the ground and fixed bodies.
+    pub fn kinematics(&self, side: usize) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
+        let i = self.sides.get(side)?.object?;
+        let b = &self.world.bodies[self.bodies[i]];
+        b.is_dynamic().then(|| (d3(b.linvel()), d3(b.angvel()), d3(b.center_of_mass())))
     }
 
     fn side_of(&self, user_data: u128) -> usize {
@@ -457,8 +482,14 @@ fn add_object(
     let collider = if dynamic {
         ColliderBuilder::new(shapes.dynamic_shape(bank, o.collider, &path)?)
     } else {
-        ColliderBuilder::trimesh(surface_points(bank), surface_triangles(bank))
-            .map_err(|e| SceneError::Collider { path: path.clone(), message: format!("{e:?}") })?
+        // Internal edges fixed: a ball rolling across a triangle boundary of a
+        // flat face must not hit the edge (a ghost collision, heard as a tick).
+        ColliderBuilder::trimesh_with_flags(
+            surface_points(bank),
+            surface_triangles(bank),
+            TriMeshFlags::FIX_INTERNAL_EDGES,
+        )
+        .map_err(|e| SceneError::Collider { path: path.clone(), message: format!("{e:?}") })?
     };
     let collider = collider
         .density(0.0)
@@ -475,6 +506,9 @@ fn add_object(
         plane_strain_pa: plane_strain_modulus(material),
         mass_kg: if dynamic { bank.mass.mass_kg } else { f64::INFINITY },
         radius_m: o.contact_radius_m.unwrap_or_else(|| default_contact_radius(bank)),
+        friction: o.friction,
+        finish: object_surface(o, bank)
+            .map_err(|(key, m)| SceneError::invalid(format!("{path}.surface.{key}"), m))?,
     };
     Ok((handle, side))
 }

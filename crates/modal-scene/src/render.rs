@@ -37,7 +37,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use modal_bank::ModeBank;
-use modal_synth::{ModalVoice, OutputGain, SynthModel, SynthOptions};
+use modal_synth::{DrivenVoice, ForceSegment, ModalVoice, OutputGain, SynthModel, SynthOptions};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -47,6 +47,7 @@ use crate::listener::{add_heard, Trajectory};
 use crate::physics::{check_ground_clearance, PairContacts, World};
 use crate::provider::resolve_banks;
 use crate::spec::{Channels, Scene};
+use crate::sustain::{ContactEvent, SustainInput, SustainedEvent, Sustainer};
 use crate::{BankProvider, SceneError};
 
 /// Characteristic impedance of air ρ₀c [Pa·s/m] (20 °C).
@@ -64,7 +65,8 @@ const RENDER_CHUNK: usize = 4096;
 /// Options of [`render`].
 #[derive(Clone, Debug, Default)]
 pub struct RenderOptions {
-    /// Keep one [`ImpactEvent`] per impact (for `--events`).
+    /// Keep one [`ImpactEvent`] per impact and one [`SustainedEvent`] per
+    /// sustained-contact segment (for `--events`).
     pub collect_events: bool,
 }
 
@@ -79,6 +81,10 @@ pub struct ObjectReport {
     pub strikes: usize,
     /// Strikes dropped because the contact point lay off the bank's surface.
     pub strikes_dropped: usize,
+    /// Sustained-contact force segments (one per contact and physics step).
+    pub force_segments: usize,
+    /// Force segments dropped because the contact point lay off the bank's surface.
+    pub force_segments_dropped: usize,
     /// Modes in the bank.
     pub modes_total: usize,
     /// Modes that can sound (not overdamped, inside 20 Hz .. 0.45 fs).
@@ -115,6 +121,8 @@ pub struct RenderReport {
     pub physics_s: f64,
     /// Seconds turning contacts into strikes.
     pub excitation_s: f64,
+    /// Seconds synthesizing the sustained-contact forces (roughness tracks).
+    pub sustained_s: f64,
     /// Seconds in modal synthesis.
     pub synthesis_s: f64,
     /// Seconds in the listener mix.
@@ -134,7 +142,12 @@ impl RenderReport {
     /// set-up, physics, excitation, synthesis and mix (bank loading or
     /// solving is reported separately in `banks_s`).
     pub fn real_time_factor(&self) -> f64 {
-        let wall = self.colliders_s + self.physics_s + self.excitation_s + self.synthesis_s + self.mix_s;
+        let wall = self.colliders_s
+            + self.physics_s
+            + self.excitation_s
+            + self.sustained_s
+            + self.synthesis_s
+            + self.mix_s;
         if wall > 0.0 {
             self.duration_s / wall
         } else {
@@ -154,6 +167,20 @@ pub struct Rendered {
     pub report: RenderReport,
     /// Impacts, if [`RenderOptions::collect_events`].
     pub events: Vec<ImpactEvent>,
+    /// Sustained-contact segments (in order of their end), if
+    /// [`RenderOptions::collect_events`].
+    pub sustained: Vec<SustainedEvent>,
+}
+
+impl Rendered {
+    /// Impacts and sustained-contact segments in order of their start time
+    /// (what `--events` writes).
+    pub fn contact_events(&self) -> Vec<ContactEvent> {
+        let mut events: Vec<ContactEvent> = self.events.iter().cloned().map(ContactEvent::Impact).collect();
+        events.extend(self.sustained.iter().cloned().map(ContactEvent::Sustained));
+        events.sort_by(|a, b| a.time_s().total_cmp(&b.time_s()));
+        events
+    }
 }
 
 /// Simulates `scene` and renders what its listener hears.
@@ -195,8 +222,8 @@ pub fn render(
     let t = Instant::now();
     let fs = scene.sample_rate_hz as f64;
     let total = (scene.duration_s * fs).round() as usize;
-    let per_object = shared_models(&banks, &names, &sim.strikes, models)?;
-    let signals = synthesize(scene, &banks, &per_object, &sim.strikes, &sim.trajectories, total)?;
+    let per_object = shared_models(&banks, &names, &sim, models)?;
+    let signals = synthesize(scene, &banks, &per_object, &sim, total)?;
     report.synthesis_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -209,6 +236,7 @@ pub fn render(
             name: names[i].clone(),
             impacts: sim.impacts[i],
             strikes: sim.strikes[i].len(),
+            force_segments: sim.segments[i].len(),
             final_position_m: sim.trajectories[i].positions.last().map_or([0.0; 3], |p| p.map(f64::from)),
             ..s.report.clone()
         });
@@ -216,11 +244,20 @@ pub fn render(
     report.impacts = sim.events_total;
     report.peak = channels.iter().flatten().fold(0.0f64, |m, x| m.max((*x as f64).abs()));
     report.clipped_samples = channels.iter().flatten().filter(|x| x.abs() > 1.0).count();
-    Ok(Rendered { channels, sample_rate: scene.sample_rate_hz, report, events: sim.events })
+    Ok(Rendered {
+        channels,
+        sample_rate: scene.sample_rate_hz,
+        report,
+        events: sim.events,
+        sustained: sim.sustained,
+    })
 }
 
 struct Simulation {
     strikes: Vec<Vec<Strike>>,
+    /// Per object: sustained-contact force segments.
+    segments: Vec<Vec<ForceSegment>>,
+    sustained: Vec<SustainedEvent>,
     impacts: Vec<usize>,
     trajectories: Vec<Trajectory>,
     events: Vec<ImpactEvent>,
@@ -242,6 +279,8 @@ fn simulate(
     let steps = (scene.duration_s * scene.physics_rate_hz).ceil() as usize;
     let mut sim = Simulation {
         strikes: vec![Vec::new(); n],
+        segments: vec![Vec::new(); n],
+        sustained: Vec::new(),
         impacts: vec![0; n],
         trajectories: vec![Trajectory { dt, positions: Vec::new() }; n],
         events: Vec::new(),
@@ -254,8 +293,11 @@ fn simulate(
     };
     record(&world, &mut sim);
     let mut exciter = Exciter::default();
+    let gravity = scene.gravity_m_s2.iter().map(|g| g * g).sum::<f64>().sqrt();
+    let mut sustainer = scene.sustained.then(|| Sustainer::new(scene.sample_rate_hz as f64, dt, gravity));
     let mut pairs: Vec<PairContacts> = Vec::new();
     let mut impacts_before = 0;
+    let mut simulated = 0;
     for k in 0..steps {
         if k > 0 && world.all_asleep() {
             break;
@@ -279,6 +321,38 @@ fn simulate(
         exciter.step(&input, &mut out);
         record(&world, &mut sim);
         report.excitation_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        if let Some(sustainer) = sustainer.as_mut() {
+            let kinematics = |side: usize| world.kinematics(side);
+            let input = SustainInput {
+                t0: k as f64 * dt,
+                pairs: &pairs,
+                sides: &world.sides,
+                names,
+                kinematics: &kinematics,
+                to_body: &to_body,
+            };
+            let events = if opts.collect_events { Some(&mut sim.sustained) } else { None };
+            sustainer.step(&input, &mut sim.segments, events);
+        }
+        report.sustained_s += t.elapsed().as_secs_f64();
+        simulated = k + 1;
+    }
+    if let Some(sustainer) = sustainer.as_mut() {
+        let t = Instant::now();
+        let kinematics = |side: usize| world.kinematics(side);
+        let to_body = |i: usize, v: [f64; 3]| world.to_body(i, v);
+        let input = SustainInput {
+            t0: simulated as f64 * dt,
+            pairs: &[],
+            sides: &world.sides,
+            names,
+            kinematics: &kinematics,
+            to_body: &to_body,
+        };
+        let events = if opts.collect_events { Some(&mut sim.sustained) } else { None };
+        sustainer.finish(&input, &mut sim.segments, events);
+        report.sustained_s += t.elapsed().as_secs_f64();
     }
     sim.events_total = impacts_before;
     Ok(sim)
@@ -300,10 +374,10 @@ fn synthesize(
     scene: &Scene,
     banks: &[Arc<ModeBank>],
     per_object: &[Option<SharedModel>],
-    strikes: &[Vec<Strike>],
-    paths: &[Trajectory],
+    sim: &Simulation,
     total: usize,
 ) -> Result<Vec<Signal>, SceneError> {
+    let paths = &sim.trajectories;
     let names = |i: usize| scene.object_name(i);
     let fs = scene.sample_rate_hz as f64;
     let ears = ears(scene);
@@ -318,11 +392,21 @@ fn synthesize(
                 parallel: false,
                 ..SynthOptions::default()
             };
-            let voice = ModalVoice::from_model(Arc::clone(model), opts)
-                .map_err(|e| SceneError::Synthesis { object: names(i), message: e.to_string() })?;
+            let failed = |e: modal_synth::SynthError| SceneError::Synthesis {
+                object: names(i),
+                message: e.to_string(),
+            };
+            let driven = if sim.segments[i].is_empty() {
+                None
+            } else {
+                Some(DrivenVoice::from_model(Arc::clone(model), opts.clone()).map_err(failed)?)
+            };
+            let voice = ModalVoice::from_model(Arc::clone(model), opts).map_err(failed)?;
             let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
-            let (near, far) = distance_range(&paths[i], &ears);
-            Ok(VoiceRun::start(voice, &strikes[i], total, fs, scale, near, far).map(|mut run| {
+            let (near_m, far_m) = distance_range(&paths[i], &ears);
+            let place = Placement { total, fs, scale, near_m, far_m };
+            let excitation = Excitation { strikes: &sim.strikes[i], segments: &sim.segments[i] };
+            Ok(VoiceRun::start(voice, driven, excitation, &place).map(|mut run| {
                 run.render_strikes(total);
                 run
             }))
@@ -375,12 +459,12 @@ fn distinct_models(banks: &[Arc<ModeBank>]) -> DistinctModels {
 fn shared_models(
     banks: &[Arc<ModeBank>],
     names: &[String],
-    strikes: &[Vec<Strike>],
+    sim: &Simulation,
     models: DistinctModels,
 ) -> Result<Vec<Option<SharedModel>>, SceneError> {
     let mut per_object = Vec::with_capacity(banks.len());
     for (i, bank) in banks.iter().enumerate() {
-        if strikes[i].is_empty() {
+        if sim.strikes[i].is_empty() && sim.segments[i].is_empty() {
             per_object.push(None);
             continue;
         }
@@ -447,14 +531,35 @@ fn equivalent_radius(bank: &ModeBank) -> f64 {
     (area / (4.0 * std::f64::consts::PI)).sqrt()
 }
 
-/// A voice being rendered in chunks of [`RENDER_CHUNK`] samples.
+/// Where and how loud a voice is heard, and the output length.
+struct Placement {
+    /// Output length [samples].
+    total: usize,
+    /// Sample rate [Hz].
+    fs: f64,
+    /// Synthesizer units → pressure at 1 m / [`FULL_SCALE_PA`].
+    scale: f64,
+    /// Nearest / farthest distance to an ear [m].
+    near_m: f64,
+    far_m: f64,
+}
+
+/// What drives one object: impacts and sustained-contact forces.
+struct Excitation<'a> {
+    strikes: &'a [Strike],
+    segments: &'a [ForceSegment],
+}
+
+/// A voice (impulses, and sustained forces if any) being rendered in
+/// chunks of [`RENDER_CHUNK`] samples.
 struct VoiceRun {
     voice: ModalVoice,
+    driven: Option<DrivenVoice>,
     /// Output sample index of `samples[0]`.
     start: usize,
     /// Next output sample to render.
     pos: usize,
-    /// The sample after which no strike is pending.
+    /// The sample after which no strike or force is pending.
     last_sample: usize,
     /// Voice output so far (synthesizer units).
     samples: Vec<f32>,
@@ -466,21 +571,19 @@ struct VoiceRun {
     near_m: f64,
     far_m: f64,
     strikes_dropped: usize,
+    segments_dropped: usize,
 }
 
 impl VoiceRun {
-    /// Applies the strikes; `None` when none of them landed.
+    /// Applies the strikes and forces; `None` when none of them landed.
     fn start(
         mut voice: ModalVoice,
-        strikes: &[Strike],
-        total: usize,
-        fs: f64,
-        scale: f64,
-        near_m: f64,
-        far_m: f64,
+        mut driven: Option<DrivenVoice>,
+        excitation: Excitation<'_>,
+        place: &Placement,
     ) -> Option<VoiceRun> {
         let (mut first, mut last, mut dropped) = (f64::INFINITY, 0.0f64, 0);
-        for s in strikes {
+        for s in excitation.strikes {
             match voice.add_impulse(s.time_s, s.point_m, s.impulse_ns, s.contact_time_s) {
                 Ok(_) => {
                     first = first.min(s.time_s);
@@ -489,21 +592,42 @@ impl VoiceRun {
                 Err(_) => dropped += 1,
             }
         }
-        let start = ((first * fs).floor() as usize).min(total);
-        let last_sample = (last * fs).ceil() as usize + 1;
+        let mut segments_dropped = 0;
+        if let Some(d) = driven.as_mut() {
+            for seg in excitation.segments {
+                let (a, b) =
+                    (seg.start as f64 / place.fs, (seg.start + seg.forces.len() as u64) as f64 / place.fs);
+                match d.add_segment(seg.clone()) {
+                    Ok(_) => {
+                        first = first.min(a);
+                        last = last.max(b);
+                    }
+                    Err(_) => segments_dropped += 1,
+                }
+            }
+        }
+        let total = place.total;
+        let start = ((first * place.fs).floor() as usize).min(total);
+        let last_sample = (last * place.fs).ceil() as usize + 1;
         let run = VoiceRun {
             voice,
+            driven,
             start,
             pos: start,
             last_sample,
             samples: Vec::new(),
             peak: 0.0,
-            scale,
-            near_m,
-            far_m,
+            scale: place.scale,
+            near_m: place.near_m,
+            far_m: place.far_m,
             strikes_dropped: dropped,
+            segments_dropped,
         };
         first.is_finite().then_some(run)
+    }
+
+    fn is_silent(&self) -> bool {
+        self.voice.is_silent() && self.driven.as_ref().is_none_or(DrivenVoice::is_silent)
     }
 
     /// Renders one chunk; returns its peak.
@@ -512,6 +636,9 @@ impl VoiceRun {
         let at = self.samples.len();
         self.samples.resize(at + len, 0.0);
         self.voice.render(&mut self.samples[at..], self.pos as u64);
+        if let Some(d) = self.driven.as_mut() {
+            d.render(&mut self.samples[at..], self.pos as u64);
+        }
         let block_peak = self.samples[at..].iter().fold(0.0f32, |m, x| m.max(x.abs()));
         self.peak = self.peak.max(block_peak);
         self.pos += len;
@@ -529,7 +656,7 @@ impl VoiceRun {
     /// voice falls silent, then fades that last chunk out (no click).
     fn render_tail(&mut self, total: usize, floor: f64) {
         while self.pos < total {
-            if self.voice.is_silent() {
+            if self.is_silent() {
                 return;
             }
             let at = self.samples.len();
@@ -551,8 +678,9 @@ impl VoiceRun {
         }
         let stats = self.voice.stats();
         report.strikes_dropped = self.strikes_dropped;
+        report.force_segments_dropped = self.segments_dropped;
         report.modes_synthesized = stats.modes_total - stats.modes_skipped;
-        report.mode_samples = stats.mode_samples;
+        report.mode_samples = stats.mode_samples + self.driven.as_ref().map_or(0, |d| d.stats().mode_samples);
         report.samples_computed = self.samples.len() as u64;
         report.peak_pa_at_1m = self.peak as f64 * self.scale * FULL_SCALE_PA;
         Signal { start: self.start, samples: self.samples, report }

@@ -42,6 +42,10 @@ pub struct Scene {
     /// Sounding objects.
     #[serde(default)]
     pub objects: Vec<ObjectSpec>,
+    /// Render sustained contact (sliding, scraping, rolling; `sustained`,
+    /// default true). False keeps only impacts.
+    #[serde(default = "defaults::yes")]
+    pub sustained: bool,
     /// Directory relative paths are resolved against (not a TOML key).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -122,6 +126,30 @@ pub struct GroundSpec {
     /// default: the thickness).
     #[serde(rename = "element_size", default)]
     pub element_size_m: Option<f64>,
+    /// Surface finish for sustained contact (default: the material's).
+    #[serde(default)]
+    pub surface: Option<SurfaceSpec>,
+}
+
+/// A surface finish (TOML table `surface`, all keys optional): a named
+/// `finish` (`polished`, `machined`, `sandblasted`, `cast`, `glazed`,
+/// `sawn`, `moulded`; default: the material's), overridden key by key.
+/// Names follow the draft glTF extension `KHR_audio_rigid_bodies`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSpec {
+    /// A named finish.
+    #[serde(default)]
+    pub finish: Option<String>,
+    /// RMS asperity height σ [m] (`roughness`).
+    #[serde(default)]
+    pub roughness: Option<f64>,
+    /// Lateral asperity spacing ℓ [m] (`correlation_length`).
+    #[serde(default)]
+    pub correlation_length: Option<f64>,
+    /// Exponent of the height power spectrum, −3 ..= −1 (`spectral_slope`).
+    #[serde(default)]
+    pub spectral_slope: Option<f64>,
 }
 
 /// Default thickness of a sounding ground slab [m].
@@ -365,6 +393,9 @@ pub struct ObjectSpec {
     /// torque `b·N` opposing its rotation (module `physics`).
     #[serde(rename = "rolling_resistance", default = "defaults::rolling_resistance")]
     pub rolling_resistance_m: f64,
+    /// Surface finish for sustained contact (default: the material's).
+    #[serde(default)]
+    pub surface: Option<SurfaceSpec>,
 }
 
 /// Default rolling-resistance lever arm [m]: 1 mm, a rolling-resistance
@@ -394,6 +425,9 @@ mod defaults {
     }
     pub fn right() -> [f64; 3] {
         [1.0, 0.0, 0.0]
+    }
+    pub fn yes() -> bool {
+        true
     }
     pub fn one() -> f64 {
         1.0

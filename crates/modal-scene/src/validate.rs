@@ -2,6 +2,7 @@
 //! materials and files. Every error names its key path.
 
 use crate::material::resolve_material;
+use crate::roughness::{check_surface, resolve_surface};
 use crate::spec::{MeshSource, ObjectSpec, RotationSpec, Scene};
 use crate::SceneError;
 
@@ -12,6 +13,11 @@ pub const MAX_DURATION_S: f64 = 3600.0;
 pub const MAX_SLAB_CELLS: f64 = 1e6;
 /// Most objects accepted in one scene.
 pub const MAX_OBJECTS: usize = 100_000;
+/// Fastest accepted initial speed of an object [m/s] (beyond it rapier's
+/// contacts and the sustained-contact model are meaningless).
+pub const MAX_SPEED_M_S: f64 = 1000.0;
+/// Fastest accepted initial spin of an object [rad/s].
+pub const MAX_ANGULAR_SPEED_RAD_S: f64 = 10_000.0;
 
 pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
     positive("duration", scene.duration_s)?;
@@ -43,6 +49,8 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
     if let Some(g) = &scene.ground {
         finite("ground.height", g.height_m)?;
         resolve_material(&g.material).map_err(|m| SceneError::invalid("ground.material", m))?;
+        resolve_surface(g.surface.as_ref(), &g.material)
+            .map_err(|(k, m)| SceneError::invalid(format!("ground.surface.{k}"), m))?;
         non_negative("ground.friction", g.friction)?;
         unit_interval("ground.restitution", g.restitution)?;
         positive("ground.thickness", g.thickness_m)?;
@@ -131,7 +139,23 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
     if let Some(r) = o.contact_radius_m {
         positive(&key("contact_radius"), r)?;
     }
+    speed_limit(&key("linear_velocity"), o.linear_velocity_m_s, MAX_SPEED_M_S, "m/s")?;
+    speed_limit(&key("angular_velocity"), o.angular_velocity_rad_s, MAX_ANGULAR_SPEED_RAD_S, "rad/s")?;
+    if let Some(s) = &o.surface {
+        // The material's default finish is resolved with the bank; the
+        // finish name and explicit keys are checked here.
+        check_surface(s).map_err(|(k, msg)| SceneError::invalid(key(&format!("surface.{k}")), msg))?;
+    }
     Ok(())
+}
+
+fn speed_limit(path: &str, v: [f64; 3], max: f64, unit: &str) -> Result<(), SceneError> {
+    let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if speed <= max {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("speed {speed} {unit} is absurd (at most {max} {unit})")))
+    }
 }
 
 fn finite(path: &str, v: f64) -> Result<(), SceneError> {

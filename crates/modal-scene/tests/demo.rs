@@ -66,10 +66,10 @@ fn demo_is_plausible_and_writes_its_files() {
     assert_eq!(report.channels, 2);
     assert_eq!(report.clipped, 0);
     let events = dir.path().join("events.json");
-    write_events_json(&out.events, &events).expect("events");
+    write_events_json(&out.contact_events(), &events).expect("events");
     let parsed: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&events).expect("read")).expect("json");
-    assert_eq!(parsed.as_array().map(Vec::len), Some(out.events.len()));
+    assert_eq!(parsed.as_array().map(Vec::len), Some(out.events.len() + out.sustained.len()));
     let png = dir.path().join("spec.png");
     write_spectrogram_png(&out.channels, &png).expect("png");
     let bytes = std::fs::read(&png).expect("png bytes");

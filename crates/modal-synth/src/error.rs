@@ -25,6 +25,9 @@ pub enum SynthError {
         /// Largest accepted bound.
         limit: f64,
     },
+    /// A force knot with a NaN, infinite or absurdly large component.
+    #[error("force [{}, {}, {}] N is not finite or exceeds 1e9 N", .0[0], .0[1], .0[2])]
+    InvalidForce([f64; 3]),
     /// A contact time that is NaN, negative or longer than the allowed maximum.
     #[error("contact time {0} s must be finite and within 0..={max} s", max = crate::contact::MAX_CONTACT_TIME_S)]
     InvalidContactTime(f64),

@@ -10,6 +10,8 @@
 //! reference), re-anchored in f64 every block so the error never grows with
 //! duration, excited phase-exactly at fractional sample times with the exact
 //! half-sine contact spectrum ([`contact`]), and dropped once inaudible.
+//! [`DrivenVoice`] ([`force`]) renders modes driven by a continuous,
+//! piecewise-linear force (sustained contact), exactly discretized.
 //! [`ModalVoice`] is the streaming engine the scene mixes; [`render_strikes`]
 //! and [`write_wav`] serve the `modal strike` command. [`reference`] is the
 //! f64 closed form every path is measured against, [`study`] the
@@ -20,6 +22,7 @@
 mod complex;
 pub mod contact;
 mod error;
+pub mod force;
 pub mod kernel;
 mod model;
 mod offline;
@@ -36,6 +39,7 @@ pub use contact::{
     effective_modulus, harmonic, hertz_contact_time, DEFAULT_CONTACT_TIME_S, MAX_CONTACT_TIME_S,
 };
 pub use error::SynthError;
+pub use force::{DrivenStats, DrivenVoice, ForceSegment};
 pub use model::{SynthModel, MAX_SNAP_FRACTION};
 pub use offline::{
     auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,

@@ -71,7 +71,7 @@ pub const MAX_TIME_S: f64 = 1e9;
 
 /// Output weight `W` with `Re(W z) = g q̇` (velocity) or `g q` (displacement),
 /// for `q = Im z` and `q̇ = Im(s z)`.
-fn weight(quantity: OutputQuantity, s: C64, g: f64) -> C64 {
+pub(crate) fn weight(quantity: OutputQuantity, s: C64, g: f64) -> C64 {
     match quantity {
         OutputQuantity::Velocity => C64::new(g * s.im, -g * s.re),
         OutputQuantity::Displacement => C64::new(0.0, -g),

@@ -33,6 +33,7 @@
 //! [`TetraError::Parse`]; the default panic hook may still print it).
 
 mod bvh;
+pub mod corpus;
 mod diagnose;
 mod error;
 mod features;

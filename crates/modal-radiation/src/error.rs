@@ -1,0 +1,83 @@
+//! Errors of the radiation solve.
+
+use thiserror::Error;
+
+/// What can go wrong in a radiation solve.
+#[derive(Debug, Error, PartialEq)]
+pub enum RadiationError {
+    /// The surface has no triangles.
+    #[error("the surface has no triangles")]
+    EmptySurface,
+    /// A surface position is NaN or infinite.
+    #[error("surface vertex {vertex} has a non-finite position")]
+    NonFinitePosition {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A triangle names a vertex that does not exist.
+    #[error("surface triangle {triangle} names a vertex that does not exist")]
+    BadTriangle {
+        /// Triangle index.
+        triangle: usize,
+    },
+    /// A triangle has (numerically) zero area.
+    #[error("surface triangle {triangle} has zero area")]
+    DegenerateTriangle {
+        /// Triangle index.
+        triangle: usize,
+    },
+    /// A frequency is not finite and positive.
+    #[error("frequency {0} Hz is not finite and positive")]
+    BadFrequency(f64),
+    /// Air density or sound speed is not finite and positive.
+    #[error("air density {density} kg/m³ and sound speed {speed} m/s must be finite and positive")]
+    BadAir {
+        /// Density [kg/m³].
+        density: f64,
+        /// Sound speed [m/s].
+        speed: f64,
+    },
+    /// A normal-velocity field has the wrong length or is not finite.
+    #[error("velocity field {field} has {got} values or non-finite ones, expected {expected} finite values")]
+    BadVelocity {
+        /// Field index.
+        field: usize,
+        /// Values given.
+        got: usize,
+        /// Panels of the mesh.
+        expected: usize,
+    },
+    /// The mode has no surface velocity to radiate.
+    #[error("mode {mode} has no normal surface velocity (all zero): nothing radiates")]
+    NoSurfaceVelocity {
+        /// Mode index in the bank.
+        mode: usize,
+    },
+    /// A field point lies inside the vibrating body.
+    #[error("point ({x}, {y}, {z}) lies inside the body: pressure is only defined outside it")]
+    PointInsideBody {
+        /// x [m].
+        x: f64,
+        /// y [m].
+        y: f64,
+        /// z [m].
+        z: f64,
+    },
+    /// The dense solve failed (singular system).
+    #[error("the boundary-element system at {frequency_hz} Hz is singular")]
+    Singular {
+        /// Frequency [Hz].
+        frequency_hz: f64,
+    },
+    /// A mode index is out of range.
+    #[error("mode {mode} does not exist (the bank has {count})")]
+    NoSuchMode {
+        /// Requested mode.
+        mode: usize,
+        /// Modes in the bank.
+        count: usize,
+    },
+    /// The bank's surface or shapes are unusable.
+    #[error("bank surface: {0}")]
+    Bank(String),
+}

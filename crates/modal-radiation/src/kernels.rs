@@ -1,0 +1,266 @@
+//! Panel integrals of the Helmholtz kernels.
+//!
+//! Time convention `e^{−iωt}`; free-space Green's function
+//! `G(x, y) = e^{ikr} / (4πr)`, `r = |y − x|`, `d = y − x`. With
+//! `G'(r) = e^{ikr}(ikr − 1)/(4πr²)`:
+//!
+//! - `∂G/∂n_y = G'(r) (d·n_y)/r`, `∂G/∂n_x = −G'(r) (d·n_x)/r`,
+//! - `∂²G/∂n_x∂n_y = e^{ikr}/(4πr³) [(1 − ikr) n_x·n_y −
+//!   (3 − 3ikr − k²r²)(d·n_x)(d·n_y)/r²]`.
+//!
+//! Regular and nearly singular panels use Dunavant's 7-point rule, the
+//! panel being split into four recursively while the point is closer than
+//! [`NEAR_RATIO`] panel diameters to the (sub)panel's centroid (thin walls,
+//! neighbours). A panel's own centroid uses polar coordinates about it,
+//! where every radial integral is closed-form and only the angle is left
+//! to Gauss–Legendre quadrature (`R(θ)` the distance to the panel edge):
+//!
+//! - `∫ G dS = (1/4π) ∮ (e^{ikR} − 1)/(ik) dθ`,
+//! - `∫ ∂G/∂n_y dS = ∫ ∂G/∂n_x dS = 0` (flat panel, `d·n = 0`),
+//! - `f.p.∫ ∂²G/∂n_x∂n_y dS = (1/4π) [2πik − ∮ e^{ikR}/R dθ]`, since
+//!   `e^{ikr}(1 − ikr)/r² = d/dr(−e^{ikr}/r)`; the Hadamard finite part
+//!   drops the `1/ε` term, which is the normal derivative of the double
+//!   layer (continuous across the surface) at the centroid.
+//!
+//! `dθ = h ℓ / R² ds` along an edge of length `ℓ` at distance `h`.
+
+use faer::c64;
+
+use crate::geometry::{cross, dot, norm, sub, BoundaryMesh, Panel};
+use crate::quadrature::TRIANGLE_7;
+
+/// A (sub)panel is split while the point is closer than this many of its
+/// diameters to its centroid.
+pub const NEAR_RATIO: f64 = 2.0;
+/// Deepest recursive split (4^depth leaves).
+pub const MAX_DEPTH: usize = 7;
+/// Gauss–Legendre points per edge in the singular (self) integrals.
+const SELF_POINTS: usize = 24;
+
+const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
+
+/// Integrals over one panel of `G`, `∂G/∂n_y`, `∂G/∂n_x`, `∂²G/∂n_x∂n_y`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PanelIntegrals {
+    /// `∫ G dS` (single layer).
+    pub g: c64,
+    /// `∫ ∂G/∂n_y dS` (double layer).
+    pub dg_dny: c64,
+    /// `∫ ∂G/∂n_x dS` (adjoint double layer).
+    pub dg_dnx: c64,
+    /// `∫ ∂²G/∂n_x∂n_y dS` (hypersingular).
+    pub d2g: c64,
+}
+
+impl std::ops::AddAssign for PanelIntegrals {
+    fn add_assign(&mut self, o: Self) {
+        self.g += o.g;
+        self.dg_dny += o.dg_dny;
+        self.dg_dnx += o.dg_dnx;
+        self.d2g += o.d2g;
+    }
+}
+
+/// Kernel evaluator at wavenumber `k` with the Gauss–Legendre rule for
+/// the self integrals.
+#[derive(Clone, Debug)]
+pub struct Kernels {
+    k: f64,
+    gl: (Vec<f64>, Vec<f64>),
+}
+
+impl Kernels {
+    /// Kernels at wavenumber `k` [1/m].
+    pub fn new(k: f64) -> Kernels {
+        let (x, w) = crate::quadrature::gauss_legendre(SELF_POINTS);
+        Kernels { k, gl: (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect()) }
+    }
+
+    /// Wavenumber [1/m].
+    pub fn k(&self) -> f64 {
+        self.k
+    }
+
+    /// Integrals over `panel` seen from `x` with normal `nx` (any unit
+    /// vector when only `g`, `dg_dny` are wanted). `x` must not lie on the
+    /// panel unless it is its centroid, which [`Kernels::self_integrals`]
+    /// handles.
+    pub fn panel(&self, mesh: &BoundaryMesh, panel: &Panel, x: [f64; 3], nx: [f64; 3]) -> PanelIntegrals {
+        let [a, b, c] = panel.corners.map(|i| mesh.vertices[i]);
+        let mut out = PanelIntegrals::default();
+        self.adaptive([a, b, c], panel.normal, panel.area, panel.diameter, x, nx, 0, &mut out);
+        out
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn adaptive(
+        &self,
+        t: [[f64; 3]; 3],
+        ny: [f64; 3],
+        area: f64,
+        diam: f64,
+        x: [f64; 3],
+        nx: [f64; 3],
+        depth: usize,
+        out: &mut PanelIntegrals,
+    ) {
+        let centroid = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
+        if depth < MAX_DEPTH && norm(sub(centroid, x)) < NEAR_RATIO * diam {
+            let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+            let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
+            for child in [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]] {
+                self.adaptive(child, ny, 0.25 * area, 0.5 * diam, x, nx, depth + 1, out);
+            }
+            return;
+        }
+        for (bary, w) in TRIANGLE_7 {
+            let y = [0, 1, 2].map(|k| bary[0] * t[0][k] + bary[1] * t[1][k] + bary[2] * t[2][k]);
+            *out += self.point(x, nx, y, ny, w * area);
+        }
+    }
+
+    /// All four kernels at one quadrature point, times the weight `w`.
+    #[inline]
+    pub fn point(&self, x: [f64; 3], nx: [f64; 3], y: [f64; 3], ny: [f64; 3], w: f64) -> PanelIntegrals {
+        let k = self.k;
+        let d = sub(y, x);
+        let r2 = dot(d, d);
+        let r = r2.sqrt();
+        let kr = k * r;
+        let (s, c) = kr.sin_cos();
+        let e = c64::new(c, s) * (w / (FOUR_PI * r));
+        let g = e;
+        // G'(r) r / G(r)... written out: G' = e^{ikr}(ikr − 1)/(4πr²).
+        let gp_over_r = e * c64::new(-1.0, kr) / r2; // G'(r)/r · w
+        let dny = dot(d, ny);
+        let dnx = dot(d, nx);
+        let d2g = e / r2
+            * (c64::new(1.0, -kr) * dot(nx, ny) - c64::new(3.0 - kr * kr, -3.0 * kr) * (dnx * dny / r2));
+        PanelIntegrals { g, dg_dny: gp_over_r * dny, dg_dnx: -gp_over_r * dnx, d2g }
+    }
+
+    /// Integrals over `panel` at its own centroid (see the module doc).
+    pub fn self_integrals(&self, mesh: &BoundaryMesh, panel: &Panel) -> PanelIntegrals {
+        let k = self.k;
+        let x = panel.centroid;
+        let [a, b, c] = panel.corners.map(|i| mesh.vertices[i]);
+        let (mut single, mut hyper) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            let e = sub(v, u);
+            let len = norm(e);
+            // Distance from x to the edge's line (x lies in the panel's plane).
+            let h = norm(cross(sub(u, x), e)) / len;
+            for (s, w) in self.gl.0.iter().zip(&self.gl.1) {
+                let y = [0, 1, 2].map(|k| u[k] + s * e[k]);
+                let rr = norm(sub(y, x));
+                let dtheta = w * h * len / (rr * rr);
+                let kr = k * rr;
+                let (sn, cs) = kr.sin_cos();
+                let eikr = c64::new(cs, sn);
+                // (e^{ikR} − 1)/(ik) = R (e^{ikR} − 1)/(ikR), series for small kR.
+                let ratio = if kr < 1e-4 {
+                    c64::new(1.0 - kr * kr / 6.0, kr / 2.0)
+                } else {
+                    (eikr - 1.0) / c64::new(0.0, kr)
+                };
+                single += ratio * (rr * dtheta);
+                hyper += eikr * (dtheta / rr);
+            }
+        }
+        PanelIntegrals {
+            g: single / FOUR_PI,
+            dg_dny: c64::new(0.0, 0.0),
+            dg_dnx: c64::new(0.0, 0.0),
+            d2g: (c64::new(0.0, 2.0 * std::f64::consts::PI * k) - hyper) / FOUR_PI,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_panel(t: [[f64; 3]; 3]) -> BoundaryMesh {
+        BoundaryMesh::new(t.to_vec(), &[[0, 1, 2]]).unwrap()
+    }
+
+    /// `∫ f` over triangle `t` by the 7-point rule on `4^depth` subtriangles.
+    fn subdivided(t: [[f64; 3]; 3], depth: usize, f: &dyn Fn([f64; 3]) -> c64) -> c64 {
+        if depth > 0 {
+            let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+            let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
+            return [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
+                .into_iter()
+                .map(|c| subdivided(c, depth - 1, f))
+                .sum();
+        }
+        let area = 0.5 * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])));
+        TRIANGLE_7
+            .iter()
+            .map(|(b, w)| f([0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k])) * (w * area))
+            .sum()
+    }
+
+    #[test]
+    fn single_layer_self_term_matches_laplace_part_plus_smooth_remainder() {
+        let t = [[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.003, 0.008, 0.0]];
+        let mesh = one_panel(t);
+        let p = &mesh.panels[0];
+        let k = 150.0;
+        let s = Kernels::new(k).self_integrals(&mesh, p);
+        let laplace = Kernels::new(1e-9).self_integrals(&mesh, p).g;
+        // (e^{ikr} − 1)/(4πr) is bounded: plain quadrature converges.
+        let x = p.centroid;
+        let smooth = subdivided(t, 5, &|y| {
+            let r = norm(sub(y, x));
+            (c64::new((k * r).cos(), (k * r).sin()) - 1.0) / (FOUR_PI * r)
+        });
+        let want = laplace + smooth;
+        assert!((s.g - want).norm() < 1e-4 * want.norm(), "{} vs {}", s.g, want);
+        // Laplace single layer of an equilateral triangle at its centroid:
+        // (1/4π) Σ_edges ∫ R dθ = (3ρ/4π) ln((1 + sin 60°)/(1 − sin 60°)), ρ the inradius.
+        let side = 0.01;
+        let e = one_panel([[0.0, 0.0, 0.0], [side, 0.0, 0.0], [side / 2.0, side * 3f64.sqrt() / 2.0, 0.0]]);
+        let rho = side / (2.0 * 3f64.sqrt());
+        let s60 = 3f64.sqrt() / 2.0;
+        let want = 3.0 * rho / FOUR_PI * ((1.0 + s60) / (1.0 - s60)).ln();
+        let got = Kernels::new(1e-9).self_integrals(&e, &e.panels[0]).g;
+        assert!((got.re - want).abs() < 1e-10 * want, "{got} vs {want}");
+    }
+
+    #[test]
+    fn hypersingular_self_term_matches_closed_forms() {
+        // k → 0: −(1/4π) ∮ dθ/R = −3√3/(4πρ) for an equilateral triangle.
+        let side = 0.02;
+        let e = one_panel([[0.0, 0.0, 0.0], [side, 0.0, 0.0], [side / 2.0, side * 3f64.sqrt() / 2.0, 0.0]]);
+        let rho = side / (2.0 * 3f64.sqrt());
+        let got = Kernels::new(1e-9).self_integrals(&e, &e.panels[0]).d2g;
+        let want = -3.0 * 3f64.sqrt() / (FOUR_PI * rho);
+        assert!((got.re - want).abs() < 1e-10 * want.abs() && got.im.abs() < 1e-6, "{got} vs {want}");
+        // k > 0: the difference to the Laplace part is the regular integral
+        // of [e^{ikr}(1 − ikr) − 1]/(4πr³) (≈ k²/(8πr) near 0), done here
+        // by brute force in polar coordinates (Gauss in angle and radius).
+        let k = 200.0;
+        let x = e.panels[0].centroid;
+        let t = [[0.0, 0.0, 0.0], [side, 0.0, 0.0], [side / 2.0, side * 3f64.sqrt() / 2.0, 0.0]];
+        let (gx, gw) = crate::quadrature::gauss_legendre(40);
+        let mut rem = c64::new(0.0, 0.0);
+        for (u, v) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let ed = sub(v, u);
+            let h = norm(cross(sub(u, x), ed)) / norm(ed);
+            for (sa, wa) in gx.iter().zip(&gw) {
+                let s = 0.5 * (sa + 1.0);
+                let rr = norm(sub([0, 1, 2].map(|q| u[q] + s * ed[q]), x));
+                let dtheta = 0.5 * wa * h * norm(ed) / (rr * rr);
+                for (ra, wr) in gx.iter().zip(&gw) {
+                    let r = 0.5 * rr * (ra + 1.0);
+                    let kr = k * r;
+                    let f = (c64::new(kr.cos(), kr.sin()) * c64::new(1.0, -kr) - 1.0) / (FOUR_PI * r * r);
+                    rem += f * (0.5 * rr * wr * dtheta);
+                }
+            }
+        }
+        let full = Kernels::new(k).self_integrals(&e, &e.panels[0]).d2g;
+        assert!((full - (want + rem)).norm() < 1e-9 * rem.norm(), "{full} vs {}", want + rem);
+    }
+}

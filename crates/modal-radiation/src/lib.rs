@@ -1,0 +1,44 @@
+//! `modal-radiation`: what a listener hears of each mode — per-mode
+//! acoustic transfer by a boundary-element solve.
+//!
+//! Input: a closed triangulated surface (one or more bodies, outward
+//! triangles; a bank's surface) and, per mode, the normal surface velocity
+//! at the mode's frequency. Output: the surface pressure ([`SurfaceField`]),
+//! pressure anywhere in the air, radiated power and radiation efficiency,
+//! and a compact outgoing [`Multipole`] expansion about the centre of mass
+//! with its order chosen to a stated error.
+//!
+//! Method ([`bem`]): exterior Neumann Helmholtz problem, time convention
+//! `e^{−iωt}`, Burton–Miller formulation (no fictitious interior
+//! resonances), constant flat panels with centroid collocation, dense
+//! complex LU (faer, sequential) and rayon row assembly: results are
+//! bit-identical for any thread count.
+//!
+//! - [`BoundaryMesh`]: panels, inside test;
+//! - [`solve`]: surface pressure for several velocity fields at one frequency;
+//! - [`multipole::fit`]: the far-field representation;
+//! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
+//! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
+//! - [`special`]: spherical Hankel functions and spherical harmonics;
+//! - [`shapes::icosphere`]: the reference sphere surface of the tests.
+
+#![warn(missing_docs)]
+
+pub mod bem;
+mod error;
+pub mod geometry;
+pub mod kernels;
+pub mod mfs;
+pub mod modes;
+pub mod multipole;
+pub mod quadrature;
+pub mod shapes;
+pub mod special;
+
+pub use bem::{solve, Air, Formulation, SurfaceField};
+pub use error::RadiationError;
+/// Complex f64 (`num_complex::Complex<f64>`), the amplitude type of every field.
+pub use faer::c64;
+pub use geometry::{BoundaryMesh, Panel};
+pub use modes::{radiate_modes, ModeRadiation, Progress, RadiationOptions};
+pub use multipole::Multipole;

@@ -1,0 +1,158 @@
+//! Special functions: spherical Hankel functions of the first kind and
+//! orthonormal complex spherical harmonics.
+//!
+//! - `h_l(x) = j_l(x) + i y_l(x)`, from `h_0(x) = −i e^{ix}/x`,
+//!   `h_1(x) = −e^{ix}(x + i)/x²` and the upward recurrence
+//!   `h_{l+1} = (2l+1)/x · h_l − h_{l−1}` (stable for `h_l`, whose modulus
+//!   grows with `l`); `h_l'(x) = h_{l−1}(x) − (l+1)/x · h_l(x)`,
+//!   `h_0' = −h_1`. Far away `h_l(x) → (−i)^{l+1} e^{ix}/x`.
+//! - `Y_l^m(θ, φ) = Q_l^m(cos θ) e^{imφ}` with `∫|Y_l^m|² dΩ = 1` and the
+//!   Condon–Shortley phase; `Q` by the standard normalized three-term
+//!   recurrence in `l`; `Y_l^{−m} = (−1)^m conj(Y_l^m)`.
+//!   Coefficient index of `(l, m)` is `l² + l + m`.
+
+use faer::c64;
+
+/// `h_l(x)` for `l = 0..=order` (`x > 0`).
+pub fn spherical_hankel(order: usize, x: f64) -> Vec<c64> {
+    let e = c64::new(x.cos(), x.sin());
+    let mut h = Vec::with_capacity(order + 1);
+    h.push(e * c64::new(0.0, -1.0 / x));
+    if order >= 1 {
+        h.push(-e * c64::new(x, 1.0) / (x * x));
+    }
+    for l in 1..order {
+        let next = h[l] * ((2 * l + 1) as f64 / x) - h[l - 1];
+        h.push(next);
+    }
+    h
+}
+
+/// `h_l'(x)` for `l = 0..=order` (`x > 0`).
+pub fn spherical_hankel_derivative(order: usize, x: f64) -> Vec<c64> {
+    let h = spherical_hankel(order + 1, x);
+    (0..=order).map(|l| if l == 0 { -h[1] } else { h[l - 1] - h[l] * ((l + 1) as f64 / x) }).collect()
+}
+
+/// Index of the coefficient of degree `l`, order `m` (`|m| ≤ l`).
+pub fn lm_index(l: usize, m: i64) -> usize {
+    ((l * l + l) as i64 + m) as usize
+}
+
+/// Orthonormal complex spherical harmonics `Y_l^m(d̂)` for every
+/// `l ≤ order`, `|m| ≤ l`, at the direction `d` (need not be unit length,
+/// must be non-zero), in the order of [`lm_index`].
+pub fn spherical_harmonics(order: usize, d: [f64; 3]) -> Vec<c64> {
+    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let x = d[2] / r;
+    let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    let (cos_phi, sin_phi) = if rho > 0.0 { (d[0] / rho, d[1] / rho) } else { (1.0, 0.0) };
+    let s = rho / r; // sin θ ≥ 0
+    let q = normalized_legendre(order, x, s);
+    let mut y = vec![c64::new(0.0, 0.0); (order + 1) * (order + 1)];
+    // e^{imφ} by repeated multiplication.
+    let mut eim = c64::new(1.0, 0.0);
+    let e1 = c64::new(cos_phi, sin_phi);
+    for m in 0..=order {
+        let sign = if m % 2 == 0 { 1.0 } else { -1.0 };
+        for l in m..=order {
+            let v = eim * q[l * (order + 1) + m];
+            y[lm_index(l, m as i64)] = v;
+            if m > 0 {
+                y[lm_index(l, -(m as i64))] = v.conj() * sign;
+            }
+        }
+        eim *= e1;
+    }
+    y
+}
+
+/// `Q_l^m(x)` for `0 ≤ m ≤ l ≤ order`, stored at `l·(order+1) + m`, with
+/// `x = cos θ`, `s = sin θ ≥ 0`.
+fn normalized_legendre(order: usize, x: f64, s: f64) -> Vec<f64> {
+    let n = order + 1;
+    let mut q = vec![0.0; n * n];
+    let mut qmm = (1.0 / (4.0 * std::f64::consts::PI)).sqrt();
+    for m in 0..=order {
+        if m > 0 {
+            qmm *= -((2 * m + 1) as f64 / (2 * m) as f64).sqrt() * s;
+        }
+        q[m * n + m] = qmm;
+        if m < order {
+            q[(m + 1) * n + m] = ((2 * m + 3) as f64).sqrt() * x * qmm;
+        }
+        for l in m + 2..=order {
+            let (lf, mf) = (l as f64, m as f64);
+            let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
+            let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0)).sqrt();
+            q[l * n + m] = a * (x * q[(l - 1) * n + m] - b * q[(l - 2) * n + m]);
+        }
+    }
+    q
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hankel_matches_closed_forms() {
+        for &x in &[0.1, 1.0, 3.7, 25.0] {
+            let h = spherical_hankel(3, x);
+            let (s, c) = (x.sin(), x.cos());
+            // j_2, y_2 closed forms.
+            let j2 = (3.0 / (x * x) - 1.0) * s / x - 3.0 * c / (x * x);
+            let y2 = -(3.0 / (x * x) - 1.0) * c / x - 3.0 * s / (x * x);
+            assert!((h[2].re - j2).abs() <= 1e-9 * h[2].norm(), "x={x}");
+            assert!((h[2].im - y2).abs() <= 1e-12 * h[2].norm(), "x={x}");
+            let j0 = s / x;
+            assert!((h[0].re - j0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn hankel_derivative_matches_finite_differences() {
+        for &x in &[0.3, 2.0, 9.0] {
+            let d = spherical_hankel_derivative(4, x);
+            let e = 1e-6;
+            let (a, b) = (spherical_hankel(4, x + e), spherical_hankel(4, x - e));
+            for l in 0..=4 {
+                let fd = (a[l] - b[l]) / (2.0 * e);
+                assert!((fd - d[l]).norm() <= 1e-6 * d[l].norm(), "l={l} x={x}");
+            }
+        }
+    }
+
+    #[test]
+    fn harmonics_are_orthonormal_on_a_product_grid() {
+        let order = 6;
+        let (nt, np) = (12, 16);
+        let (nodes, weights) = crate::quadrature::gauss_legendre(nt);
+        let nc = (order + 1) * (order + 1);
+        let mut gram = vec![c64::new(0.0, 0.0); nc * nc];
+        for (t, w) in nodes.iter().zip(&weights) {
+            for p in 0..np {
+                let phi = 2.0 * std::f64::consts::PI * p as f64 / np as f64;
+                let st = (1.0 - t * t).sqrt();
+                let y = spherical_harmonics(order, [st * phi.cos(), st * phi.sin(), *t]);
+                let wq = w * 2.0 * std::f64::consts::PI / np as f64;
+                for a in 0..nc {
+                    for b in 0..nc {
+                        gram[a * nc + b] += y[a] * y[b].conj() * wq;
+                    }
+                }
+            }
+        }
+        for a in 0..nc {
+            for b in 0..nc {
+                let want = if a == b { 1.0 } else { 0.0 };
+                assert!((gram[a * nc + b] - want).norm() < 1e-12, "{a} {b} {}", gram[a * nc + b]);
+            }
+        }
+        // Y_1^0 = sqrt(3/4π) cos θ.
+        let y = spherical_harmonics(1, [0.3, -0.2, 0.5]);
+        let r = (0.09f64 + 0.04 + 0.25).sqrt();
+        let want = (3.0 / (4.0 * std::f64::consts::PI)).sqrt() * 0.5 / r;
+        assert!((y[lm_index(1, 0)].re - want).abs() < 1e-15);
+    }
+}

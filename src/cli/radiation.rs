@@ -1,0 +1,169 @@
+//! `modal radiation`: the pressure each mode radiates to points around the
+//! object, and its radiated power (acoustic transfer, `modal-radiation`).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{ensure, Context, Result};
+use clap::Args;
+use modal_radiation::{Air, RadiationOptions};
+use serde::Serialize;
+
+use super::bank_cmds::load_bank;
+use super::output::print_json;
+
+/// Lowest frequency treated as audible [Hz].
+pub const AUDIBLE_MIN_HZ: f64 = 20.0;
+
+#[derive(Debug, Args)]
+pub struct RadiationArgs {
+    /// Mode bank.
+    pub bank: PathBuf,
+    /// Field point X,Y,Z [m] in the bank's frame (outside the body); repeat for several.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point, allow_hyphen_values = true)]
+    pub point: Vec<[f64; 3]>,
+    /// Air density ρ₀ [kg/m³].
+    #[arg(long, value_name = "KG_M3", default_value_t = 1.21, allow_negative_numbers = true)]
+    pub air_density: f64,
+    /// Speed of sound c [m/s].
+    #[arg(long, value_name = "M_S", default_value_t = 343.0, allow_negative_numbers = true)]
+    pub sound_speed: f64,
+    /// Highest mode frequency solved [Hz]; modes above it cannot be heard.
+    #[arg(long, value_name = "HZ", default_value_t = 20_000.0)]
+    pub max_freq: f64,
+    /// Only these modes (indices into the bank; repeatable); default: every audible mode.
+    #[arg(long, value_name = "I")]
+    pub mode: Vec<usize>,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_point(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("expected X,Y,Z (three numbers), got \"{text}\""));
+    }
+    let mut p = [0.0; 3];
+    for (slot, s) in p.iter_mut().zip(parts) {
+        *slot = s.trim().parse::<f64>().map_err(|_| format!("\"{s}\" is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("\"{s}\" is not finite"));
+        }
+    }
+    Ok(p)
+}
+
+#[derive(Serialize)]
+struct RadiationJson {
+    air_density_kg_m3: f64,
+    sound_speed_m_s: f64,
+    points: Vec<[f64; 3]>,
+    modes: Vec<ModeJson>,
+    /// Modes not solved because they cannot be heard (outside [20 Hz, --max-freq]).
+    modes_skipped: Vec<usize>,
+    panels: usize,
+    seconds: f64,
+}
+
+#[derive(Serialize)]
+struct ModeJson {
+    index: usize,
+    frequency_hz: f64,
+    radiated_power_w: f64,
+    radiation_efficiency: f64,
+    multipole_order: usize,
+    pressure_pa: Vec<[f64; 2]>,
+}
+
+pub fn run(args: RadiationArgs) -> Result<()> {
+    let started = Instant::now();
+    let bank = load_bank(&args.bank)?;
+    let air = Air { density_kg_m3: args.air_density, sound_speed_m_s: args.sound_speed };
+    air.validate()?;
+    ensure!(args.max_freq > 0.0, "--max-freq must be positive");
+    let mesh = modal_radiation::modes::boundary_mesh(&bank).context("the bank's surface cannot be used")?;
+    for p in &args.point {
+        ensure!(
+            !mesh.contains(*p),
+            "point {},{},{} lies inside the body: pressure is only defined outside it",
+            p[0],
+            p[1],
+            p[2]
+        );
+    }
+    let audible = |i: usize| {
+        let f = bank.damped_frequency_hz(i);
+        f >= AUDIBLE_MIN_HZ && bank.frequencies_hz[i] <= args.max_freq
+    };
+    for &m in &args.mode {
+        ensure!(m < bank.mode_count(), "mode {m} does not exist (the bank has {} modes)", bank.mode_count());
+    }
+    let candidates: Vec<usize> =
+        if args.mode.is_empty() { (0..bank.mode_count()).collect() } else { args.mode.clone() };
+    let (modes, skipped): (Vec<usize>, Vec<usize>) = candidates.into_iter().partition(|&i| audible(i));
+    eprintln!(
+        "radiation: {} mode(s) on {} panels ({} skipped as inaudible)",
+        modes.len(),
+        mesh.len(),
+        skipped.len()
+    );
+    let opts = RadiationOptions { air, ..RadiationOptions::default() };
+    let results =
+        modal_radiation::modes::radiate_modes_on(&bank, &mesh, &modes, &opts, &mut |p| eprintln!("{p}"))?;
+    let mut out = Vec::with_capacity(results.len());
+    for r in &results {
+        let mut pressure = Vec::with_capacity(args.point.len());
+        for p in &args.point {
+            let z = r.surface.pressure_at(&mesh, *p)?;
+            pressure.push([z.re, z.im]);
+        }
+        out.push(ModeJson {
+            index: r.mode,
+            frequency_hz: r.frequency_hz,
+            radiated_power_w: r.power_w,
+            radiation_efficiency: r.efficiency,
+            multipole_order: r.multipole.order,
+            pressure_pa: pressure,
+        });
+    }
+    out.sort_by_key(|m| m.index);
+    let seconds = started.elapsed().as_secs_f64();
+    eprintln!("radiation: done in {seconds:.2} s");
+    let report = RadiationJson {
+        air_density_kg_m3: air.density_kg_m3,
+        sound_speed_m_s: air.sound_speed_m_s,
+        points: args.point.clone(),
+        modes: out,
+        modes_skipped: skipped,
+        panels: mesh.len(),
+        seconds,
+    };
+    if args.json {
+        return print_json(&report);
+    }
+    println!(
+        "{:>5} {:>11} {:>12} {:>10} {:>5}  level at each point [dB SPL]",
+        "mode", "freq [Hz]", "power [W]", "efficiency", "order"
+    );
+    for m in &report.modes {
+        let levels: Vec<String> = m
+            .pressure_pa
+            .iter()
+            .map(|[re, im]| {
+                let rms = (re * re + im * im).sqrt() / 2f64.sqrt();
+                format!("{:.1}", 20.0 * (rms / 20e-6).log10())
+            })
+            .collect();
+        println!(
+            "{:>5} {:>11.2} {:>12.4e} {:>10.3e} {:>5}  {}",
+            m.index,
+            m.frequency_hz,
+            m.radiated_power_w,
+            m.radiation_efficiency,
+            m.multipole_order,
+            levels.join(" ")
+        );
+    }
+    Ok(())
+}
