@@ -28,6 +28,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
             let (mesh, tet_report) = modal_tetra::tetrahedralize(&surface, &options)
                 .with_context(|| format!("cannot tetrahedralize {}", input.display()))?;
             write_mesh(&out, &mesh)?;
+            tet_report.warnings.iter().for_each(|w| warn(w));
             let r = &tet_report;
             let summary = serde_json::json!({
                 "out": out.display().to_string(),
@@ -40,6 +41,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
                 "volume_m3": r.volume_m3,
                 "surface_volume_m3": r.surface_volume_m3,
                 "max_surface_deviation_m": r.max_surface_deviation_m,
+                "hinged_tets_dropped": r.hinged_tets_dropped,
             });
             if json {
                 print_json(&summary)

@@ -240,7 +240,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))?;
     }
     if let Some(path) = &args.spectrogram {
-        interrupt::guarded(|| modal_scene::write_spectrogram_png(&rendered.channels, path))?;
+        interrupt::guarded(|| {
+            modal_scene::write_spectrogram_png(&rendered.channels, rendered.sample_rate, path)
+        })?;
     }
     let report = &rendered.report;
     if args.json {

@@ -5,7 +5,8 @@
 //! generator (box, cylinder, tube, sphere, bowl; [`generate::generate`]).
 //! [`check`] turns a raw mesh into one the FEM can trust: positively
 //! oriented tets, no degenerate or inverted elements, unused nodes dropped,
-//! connected parts counted ([`MeshReport`]). [`boundary_surface`] extracts
+//! parts found through shared faces, parts that touch only at an edge or a
+//! vertex (hinges) split into separate bodies ([`MeshReport`], [`face_parts`]). [`boundary_surface`] extracts
 //! the outward boundary [`Surface`] (used by the mode bank and the
 //! synthesizer); [`to_quadratic`] / [`to_linear`] change the element order;
 //! [`write_msh41`] writes Gmsh MSH 4.1 that Gmsh and meshio open.
@@ -27,6 +28,7 @@ mod closest;
 mod error;
 mod measure;
 mod overlap;
+mod parts;
 mod promote;
 mod quality;
 mod surface;
@@ -40,6 +42,7 @@ pub use closest::closest_point_on_triangle;
 pub use error::{Location, MeshError};
 pub use io::{read_mesh, write_msh41, write_msh41_file};
 pub use measure::{mesh_volume, tet_volume};
+pub use parts::{describe_hinges, face_parts, split_hinges, FaceParts, Hinge};
 pub use promote::{to_linear, to_quadratic, to_quadratic_with};
 pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;

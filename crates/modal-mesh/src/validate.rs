@@ -21,8 +21,12 @@
 //!    det J is a cubic polynomial, so this is a sampled check, the standard
 //!    one in FE codes → error naming the element and the point;
 //! 7. unused nodes are dropped (indices renumbered, order kept) and counted;
-//! 8. connected parts (through shared nodes) are counted: each part has its
-//!    own six rigid-body modes;
+//! 8. parts are found through shared faces ([`crate::face_parts`]); parts
+//!    that touch only at an edge or a vertex (zero-stiffness hinges) get
+//!    their own copies of the shared nodes ([`crate::split_hinges`]) and a
+//!    warning naming each contact, so they are solved as separate bodies;
+//!    after that the node-connected parts ([`connected_parts`]) are the
+//!    face-connected ones, each with its own six rigid-body modes;
 //! 9. quality: the smallest dihedral angle is reported and tets with one
 //!    below 5° are counted as slivers (a warning only).
 
@@ -64,8 +68,13 @@ pub struct MeshReport {
     pub reoriented: usize,
     /// Nodes used by no tet, dropped.
     pub unused_nodes_dropped: usize,
-    /// Connected parts (each contributes six rigid-body modes).
+    /// Parts connected through shared faces (each contributes six
+    /// rigid-body modes), after hinges were split.
     pub parts: usize,
+    /// Pairs of parts that touched only at edges or vertices (hinges).
+    pub hinges: usize,
+    /// Nodes duplicated to separate hinged parts.
+    pub hinge_nodes_split: usize,
     /// Total volume (m³) (straight-sided corner tets).
     pub volume: f64,
     /// Smallest corner-tet volume (m³).
@@ -98,9 +107,23 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
         }
     }
     let dropped = drop_unused_nodes(&mut mesh);
+    let mut warnings = Vec::new();
+    let face = crate::face_parts(&mesh);
+    let hinges = face.hinges.len();
+    let hinge_nodes_split = if hinges > 0 {
+        let added = crate::split_hinges(&mut mesh, &face);
+        warnings.push(format!(
+            "{} parts touch only at edges or vertices (zero-stiffness hinges, {added} nodes duplicated): {}; \
+             they are solved as separate bodies (remesh or join them to couple them)",
+            face.count,
+            crate::describe_hinges(&face, 3)
+        ));
+        added
+    } else {
+        0
+    };
     let (parts, _) = connected_parts(&mesh);
     let (min_dihedral_deg, slivers) = dihedral_summary(&mesh);
-    let mut warnings = Vec::new();
     if reoriented > 0 {
         warnings.push(format!(
             "{reoriented} of {} tets were negatively oriented and have been reoriented",
@@ -126,6 +149,8 @@ pub fn check(mut mesh: TetMesh) -> Result<(TetMesh, MeshReport), MeshError> {
         reoriented,
         unused_nodes_dropped: dropped,
         parts,
+        hinges,
+        hinge_nodes_split,
         volume,
         min_tet_volume: min_v,
         max_tet_volume: max_v,

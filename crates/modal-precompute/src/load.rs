@@ -70,7 +70,8 @@ pub fn load_mesh(
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
             warnings.extend(report.warnings.iter().cloned());
-            let (mesh, _) = modal_tetra::tetrahedralize(&surf, &surface.tet_options())?;
+            let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &surface.tet_options())?;
+            warnings.extend(tet_report.warnings);
             mesh
         }
         MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,

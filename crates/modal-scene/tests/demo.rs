@@ -71,7 +71,7 @@ fn demo_is_plausible_and_writes_its_files() {
         serde_json::from_str(&std::fs::read_to_string(&events).expect("read")).expect("json");
     assert_eq!(parsed.as_array().map(Vec::len), Some(out.events.len() + out.sustained.len()));
     let png = dir.path().join("spec.png");
-    write_spectrogram_png(&out.channels, &png).expect("png");
+    write_spectrogram_png(&out.channels, out.sample_rate, &png).expect("png");
     let bytes = std::fs::read(&png).expect("png bytes");
     assert_eq!(&bytes[1..4], b"PNG");
     // Nothing but the three files (no temporaries left behind).

@@ -4,7 +4,7 @@
 //! measured error and run time ([`CaseResult`], from [`run_case`]), fitted
 //! convergence rates and the cheapest mesh meeting an error target
 //! ([`StudyReport`]), and log-log PNG plots ([`plot::write_loglog_png`]) drawn with
-//! `plotters` and a built-in bitmap font (no system font libraries).
+//! `plotters` and the DejaVu Sans font embedded by `modal-plot` (no system font libraries).
 //!
 //! Shapes and references (module [`reference`]): the free-free steel bar and the
 //! free steel sphere of `shared/reference/analytic.md`, and the bar as a cantilever.
@@ -15,7 +15,6 @@ mod case;
 mod compare;
 mod error;
 mod fit;
-mod font;
 mod memory;
 pub mod plot;
 pub mod reference;

@@ -1,5 +1,5 @@
-//! Log-log line plots as PNG, drawn with `plotters`' bitmap backend and the
-//! built-in 5×7 bitmap font of [`crate::font`] (no system font libraries).
+//! Log-log line plots as PNG, drawn with `plotters`' bitmap backend; text in
+//! the DejaVu Sans font embedded by `modal-plot` (no system font libraries).
 //!
 //! Axes: a point `(x, y)` maps to `(log10 x, log10 y)`; each axis spans whole
 //! decades from `floor(log10 min)` to `ceil(log10 max)` of the positive,
@@ -8,7 +8,7 @@
 //! place on a log axis). The file is written to a temporary name in the same
 //! directory and renamed, so a reader never sees a partial PNG.
 
-use crate::font::{draw_text, text_width, Direction, LINE};
+use modal_plot::{draw_text, HPos, Text, VPos};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -65,8 +65,12 @@ pub enum PlotError {
 const SIZE: (u32, u32) = (960, 640);
 /// Plot frame in pixels: left, top, right, bottom.
 const FRAME: (i32, i32, i32, i32) = (110, 60, 700, 560);
-/// Text scale (image pixels per font pixel) for titles and labels.
-const TEXT: i32 = 2;
+/// Text sizes [px]: title, axis labels, tick labels and legend.
+const TITLE: f32 = 22.0;
+const LABEL: f32 = 18.0;
+const TICK: f32 = 16.0;
+/// Legend line spacing [px].
+const LINE: i32 = 26;
 /// Line colours of successive series.
 const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
@@ -177,15 +181,7 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
         let (x, _) = axes.px(10f64.powi(k), 1.0);
         area.draw(&PathElement::new(vec![(x, t), (x, b)], GRID))?;
         area.draw(&PathElement::new(vec![(x, b), (x, b + 8)], BLACK))?;
-        let label = decade_label(k);
-        draw_text(
-            area,
-            &label,
-            (x - text_width(&label, TEXT) / 2, b + 14),
-            TEXT,
-            Direction::Horizontal,
-            &BLACK,
-        )?;
+        draw_text(area, &decade_label(k), (x, b + 12), &Text::new(TICK).at(HPos::Center, VPos::Top))?;
         for m in 2..10 {
             let (xm, _) = axes.px(m as f64 * 10f64.powi(k), 1.0);
             if k < axes.xs.1 {
@@ -197,9 +193,7 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
         let (_, y) = axes.px(1.0, 10f64.powi(k));
         area.draw(&PathElement::new(vec![(l, y), (r, y)], GRID))?;
         area.draw(&PathElement::new(vec![(l - 8, y), (l, y)], BLACK))?;
-        let label = decade_label(k);
-        let origin = (l - 12 - text_width(&label, TEXT), y - LINE * TEXT / 2);
-        draw_text(area, &label, origin, TEXT, Direction::Horizontal, &BLACK)?;
+        draw_text(area, &decade_label(k), (l - 12, y), &Text::new(TICK).at(HPos::Right, VPos::Center))?;
         for m in 2..10 {
             let (_, ym) = axes.px(1.0, m as f64 * 10f64.powi(k));
             if k < axes.ys.1 {
@@ -212,25 +206,9 @@ fn draw_grid(area: &Area, axes: &Axes) -> DrawResult {
 
 fn draw_labels(area: &Area, plot: &LogLogPlot, _axes: &Axes) -> DrawResult {
     let (l, t, r, b) = FRAME;
-    let center = |text: &str, mid: i32| mid - text_width(text, TEXT) / 2;
-    draw_text(
-        area,
-        plot.title,
-        (center(plot.title, (l + r) / 2), t - 40),
-        TEXT,
-        Direction::Horizontal,
-        &BLACK,
-    )?;
-    draw_text(
-        area,
-        plot.x_label,
-        (center(plot.x_label, (l + r) / 2), b + 44),
-        TEXT,
-        Direction::Horizontal,
-        &BLACK,
-    )?;
-    let y_mid = (t + b) / 2 + text_width(plot.y_label, TEXT) / 2;
-    draw_text(area, plot.y_label, (16, y_mid), TEXT, Direction::Up, &BLACK)
+    draw_text(area, plot.title, ((l + r) / 2, t - 18), &Text::new(TITLE).at(HPos::Center, VPos::Bottom))?;
+    draw_text(area, plot.x_label, ((l + r) / 2, b + 42), &Text::new(LABEL).at(HPos::Center, VPos::Top))?;
+    draw_text(area, plot.y_label, (14, (t + b) / 2), &Text::new(LABEL).at(HPos::Center, VPos::Top).upwards())
 }
 
 fn draw_series(area: &Area, axes: &Axes, series: &Series, color: &RGBColor) -> DrawResult {
@@ -247,12 +225,11 @@ fn draw_series(area: &Area, axes: &Axes, series: &Series, color: &RGBColor) -> D
 fn draw_legend(area: &Area, series: &[Series]) -> DrawResult {
     let (_, t, r, _) = FRAME;
     for (i, s) in series.iter().enumerate() {
-        let y = t + 10 + i as i32 * (LINE * TEXT + 10);
+        let mid = t + 20 + i as i32 * LINE;
         let color = PALETTE[i % PALETTE.len()];
-        let mid = y + LINE * TEXT / 2 - 1;
         area.draw(&PathElement::new(vec![(r + 16, mid), (r + 46, mid)], color.stroke_width(2)))?;
         area.draw(&Circle::new((r + 31, mid), 4, color.filled()))?;
-        draw_text(area, &s.label, (r + 54, y), TEXT, Direction::Horizontal, &BLACK)?;
+        draw_text(area, &s.label, (r + 54, mid), &Text::new(TICK).at(HPos::Left, VPos::Center))?;
     }
     Ok(())
 }

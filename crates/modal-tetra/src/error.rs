@@ -82,9 +82,11 @@ pub enum TetraError {
         limit: usize,
     },
     /// The surface encloses no volume at the chosen resolution.
-    #[error("no tets: the surface encloses no volume thicker than the cell size {cell_m:.3e} m (is it an open sheet, or is --cell too coarse?)")]
+    #[error("no tets at cell size {cell_m:.3e} m: {hint}")]
     NoVolume {
         /// Cell size used (m).
         cell_m: f64,
+        /// What to do: a cell that works, or why none will.
+        hint: String,
     },
 }

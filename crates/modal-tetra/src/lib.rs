@@ -17,7 +17,11 @@
 //!    crossing, lattice points near the surface snapped onto it, stencils clip
 //!    lattice tets to the inside. Dihedral angles stay within [9°, 166°]
 //!    (checked by the tests on every output).
-//! 4. Sharp features (module `features`): boundary nodes near sharp input
+//! 4. Hinges: small face-connected pieces that touch the rest only at an
+//!    edge or a vertex are dropped ([`HINGED_DROP_FRACTION`]); larger ones
+//!    get their own copies of the shared nodes (separate bodies), so no
+//!    output tets are joined by an edge or a vertex only.
+//! 5. Sharp features (module `features`): boundary nodes near sharp input
 //!    edges and corners are moved onto them when quality allows.
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
@@ -51,6 +55,7 @@ pub use features::{FEATURE_ANGLE_DEG, GUARD_DEG, SNAP_FRACTION};
 pub use geom::dihedral_angles_deg;
 pub use mesher::{
     tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL, DEFAULT_CELLS_PER_THICKNESS,
+    HINGED_DROP_FRACTION,
 };
 pub use read::{parse_surface, read_surface, SurfaceFormat};
 pub use stuff::{ALPHA_LONG, ALPHA_SHORT};

@@ -64,7 +64,7 @@ impl TetOptions {
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
         format!(
-            "tetra=stuffing-v1;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={}",
+            "tetra=stuffing-v2;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={}",
             self.cell, self.target_tets, self.cells_per_diagonal, self.cells_per_thickness, self.preserve_features
         )
     }
@@ -93,11 +93,136 @@ pub struct TetReport {
     pub dropped_degenerate: usize,
     /// Boundary nodes moved onto sharp input edges and corners.
     pub feature_nodes_snapped: usize,
+    /// Small pieces that hung on a larger one by an edge or a vertex only
+    /// (zero-stiffness hinges) and were dropped (see [`HINGED_DROP_FRACTION`]).
+    pub hinged_pieces_dropped: usize,
+    /// Tets in those pieces.
+    pub hinged_tets_dropped: usize,
+    /// Contacts between larger pieces through edges or vertices only, split
+    /// so that the pieces are separate bodies (node copies).
+    pub hinges_split: usize,
+    /// What the user should know about the mesh (one line each).
+    pub warnings: Vec<String>,
+}
+
+/// A face-connected piece of the stuffed mesh that touches a larger piece
+/// only at edges or vertices is dropped when it holds at most this fraction
+/// of all tets: such pieces are lattice artefacts where the solid is thinner
+/// than the cell, and would be zero-stiffness mechanisms. Larger hinged
+/// pieces are kept as separate bodies (their shared nodes are duplicated).
+pub const HINGED_DROP_FRACTION: f64 = 0.01;
+
+struct HingedDrop {
+    pieces: usize,
+    tets: usize,
+    split: usize,
+    warnings: Vec<String>,
+}
+
+/// Drops small hinged pieces (see [`HINGED_DROP_FRACTION`]) and the nodes
+/// only they used, then splits the remaining hinges (the pieces become
+/// separate bodies), so no two output tets share only an edge or a vertex
+/// without being joined through faces.
+fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
+    let mesh = TetMesh {
+        nodes: std::mem::take(&mut stuffed.nodes),
+        cells: Cells::Tet4(std::mem::take(&mut stuffed.tets)),
+        groups: Vec::new(),
+    };
+    let parts = modal_mesh::face_parts(&mesh);
+    let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
+    let (mut nodes, mut tets) = (mesh.nodes, tets);
+    let limit = HINGED_DROP_FRACTION * tets.len() as f64;
+    // Clusters of pieces linked by hinges (chains included): each keeps its
+    // largest piece; the others that are small are dropped.
+    let mut cluster: Vec<usize> = (0..parts.count).collect();
+    fn root(c: &mut [usize], mut x: usize) -> usize {
+        while c[x] != x {
+            c[x] = c[c[x]];
+            x = c[x];
+        }
+        x
+    }
+    for h in &parts.hinges {
+        let (a, b) = (root(&mut cluster, h.parts[0]), root(&mut cluster, h.parts[1]));
+        cluster[a.max(b)] = a.min(b);
+    }
+    let mut largest = vec![usize::MAX; parts.count];
+    for p in 0..parts.count {
+        let r = root(&mut cluster, p);
+        if largest[r] == usize::MAX || parts.tets[p] > parts.tets[largest[r]] {
+            largest[r] = p;
+        }
+    }
+    let mut drop = vec![false; parts.count];
+    let mut places = Vec::new();
+    for h in &parts.hinges {
+        for p in h.parts {
+            let r = root(&mut cluster, p);
+            if p != largest[r] && parts.tets[p] as f64 <= limit && !drop[p] {
+                drop[p] = true;
+                places.push(h.at);
+            }
+        }
+    }
+    let pieces = drop.iter().filter(|&&d| d).count();
+    let mut warnings = Vec::new();
+    let mut dropped = 0;
+    if pieces > 0 {
+        let kept: Vec<[usize; 4]> =
+            tets.iter().zip(&parts.part_of_tet).filter(|(_, &p)| !drop[p]).map(|(t, _)| *t).collect();
+        dropped = tets.len() - kept.len();
+        let mut index = vec![usize::MAX; nodes.len()];
+        let mut next = 0;
+        for t in &kept {
+            for &v in t {
+                if index[v] == usize::MAX {
+                    index[v] = next;
+                    next += 1;
+                }
+            }
+        }
+        let mut compact = vec![[0.0; 3]; next];
+        for (v, &i) in index.iter().enumerate() {
+            if i != usize::MAX {
+                compact[i] = nodes[v];
+            }
+        }
+        nodes = compact;
+        tets = kept.into_iter().map(|t| t.map(|v| index[v])).collect();
+        let p = places[0];
+        warnings.push(format!(
+            "dropped {pieces} small piece(s) of the tet mesh ({dropped} tets) that hung on the rest by an edge or a \
+             vertex only, first near ({:.4}, {:.4}, {:.4}) m: the solid is thinner than the cell there (a smaller \
+             --cell keeps it)",
+            p[0], p[1], p[2]
+        ));
+    }
+    // Larger hinged pieces become separate bodies: each gets its own nodes.
+    let mut mesh = TetMesh { nodes, cells: Cells::Tet4(tets), groups: Vec::new() };
+    let parts = modal_mesh::face_parts(&mesh);
+    let mut split = 0;
+    if !parts.hinges.is_empty() {
+        split = parts.hinges.len();
+        let added = modal_mesh::split_hinges(&mut mesh, &parts);
+        warnings.push(format!(
+            "{} pieces of the tet mesh touch only at edges or vertices ({added} nodes duplicated): {}; they are \
+             solved as separate bodies (a smaller --cell may join them through faces)",
+            parts.count,
+            modal_mesh::describe_hinges(&parts, 3)
+        ));
+    }
+    let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
+    stuffed.nodes = mesh.nodes;
+    stuffed.tets = tets;
+    HingedDrop { pieces, tets: dropped, split, warnings }
 }
 
 /// Tetrahedralizes the solid bounded by `surface` (see the crate doc).
 ///
-/// The result has 4-node, positively oriented tets and no unused nodes.
+/// The result has 4-node, positively oriented tets and no unused nodes;
+/// small pieces that would hang on the rest by an edge or a vertex only are
+/// dropped ([`HINGED_DROP_FRACTION`]).
 pub fn tetrahedralize(
     surface: &TriSurface,
     options: &TetOptions,
@@ -114,16 +239,60 @@ pub fn tetrahedralize(
         .iter()
         .map(|t| norm(area_vector(repaired.vertices[t[0]], repaired.vertices[t[1]], repaired.vertices[t[2]])))
         .sum();
-    let h = cell_size(options, diagonal, repaired.report.enclosed_volume_m3, area)?;
-    let lattice = Lattice::covering(lo, hi, h, 2);
-    check_size(&lattice, repaired.report.enclosed_volume_m3, options.max_tets)?;
-
+    let volume = repaired.report.enclosed_volume_m3;
+    let h0 = cell_size(options, diagonal, volume, area)?;
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
     let bvh = Bvh::new(tris);
-    let mut stuffed = stuff(&lattice, &bvh);
+    let mut warnings = Vec::new();
+    let mut h = h0;
+    let mut stuffed = stuff_at(lo, hi, h, volume, options.max_tets, &bvh)?;
     if stuffed.tets.is_empty() {
-        return Err(TetraError::NoVolume { cell_m: h });
+        if volume <= SHEET_VOLUME * diagonal.powi(3) {
+            return Err(TetraError::NoVolume {
+                cell_m: h0,
+                hint: "the surface encloses no volume at all (an open sheet without thickness): close it or give it a thickness".into(),
+            });
+        }
+        // Thinner than the cell: try finer cells (within the size limit).
+        let mut found = None;
+        for _ in 0..FALLBACK_HALVINGS {
+            h *= 0.5;
+            match stuff_at(lo, hi, h, volume, options.max_tets, &bvh) {
+                Ok(s) if !s.tets.is_empty() => {
+                    found = Some(s);
+                    break;
+                }
+                Ok(_) => {}
+                Err(_) => break,
+            }
+        }
+        match (found, options.cell) {
+            (Some(s), None) => {
+                warnings.push(format!(
+                    "no tets at the default cell {h0:.3e} m (the solid is thinner than that); used --cell {h:.3e} m"
+                ));
+                stuffed = s;
+            }
+            (Some(s), Some(_)) => {
+                return Err(TetraError::NoVolume {
+                    cell_m: h0,
+                    hint: format!(
+                        "the solid is thinner than the cell; --cell {h:.3e} works ({} tets)",
+                        s.tets.len()
+                    ),
+                });
+            }
+            (None, _) => {
+                return Err(TetraError::NoVolume {
+                    cell_m: h0,
+                    hint: format!(
+                        "the solid is thinner than the cell, and cells down to {h:.3e} m found none either (is it an open sheet, or much thinner than its size?)"
+                    ),
+                });
+            }
+        }
     }
+    let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     let feature_nodes_snapped = if options.preserve_features {
         let (segments, corners) = features(&repaired.vertices, &repaired.triangles);
@@ -144,6 +313,10 @@ pub fn tetrahedralize(
         max_surface_deviation_m,
         dropped_degenerate: stuffed.dropped,
         feature_nodes_snapped,
+        hinged_pieces_dropped: hinged.pieces,
+        hinged_tets_dropped: hinged.tets,
+        hinges_split: hinged.split,
+        warnings: warnings.into_iter().chain(hinged.warnings).collect(),
     };
     let mesh = TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() };
     Ok((mesh, report))
@@ -177,6 +350,25 @@ fn cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -> Res
         h = h.min(2.0 * volume / area / options.cells_per_thickness);
     }
     positive("cell", h)
+}
+
+/// Halvings of the cell tried when the first cell gives no tets.
+const FALLBACK_HALVINGS: usize = 2;
+/// Enclosed volume (× diagonal³) at or below which a surface is a sheet.
+const SHEET_VOLUME: f64 = 1e-9;
+
+/// Stuffs the solid on a lattice of cell `h` after checking its size.
+fn stuff_at(
+    lo: V3,
+    hi: V3,
+    h: f64,
+    volume: f64,
+    max_tets: usize,
+    bvh: &Bvh,
+) -> Result<crate::stuff::Stuffed, TetraError> {
+    let lattice = Lattice::covering(lo, hi, h, 2);
+    check_size(&lattice, volume, max_tets)?;
+    Ok(stuff(&lattice, bvh))
 }
 
 fn check_size(lattice: &Lattice, volume: f64, limit: usize) -> Result<(), TetraError> {

@@ -236,6 +236,7 @@ fn open_sheet_fails_with_a_clear_reason() {
     let e = tetrahedralize(&s, &TetOptions::default()).unwrap_err();
     assert!(matches!(e, TetraError::NoVolume { .. }), "{e}");
     assert!(!e.to_string().contains('\n'));
+    assert!(e.to_string().contains("open sheet"), "{e}");
     let empty = TriSurface::default();
     assert!(matches!(tetrahedralize(&empty, &TetOptions::default()), Err(TetraError::Empty)));
     let mut nan = sphere();
@@ -253,4 +254,49 @@ fn robust_200k_triangles() {
     assert!(s.triangles.len() > 200_000);
     let r = mesh(&s);
     assert!(rel(r.volume_m3, r.surface_volume_m3).abs() < 0.01, "{r:?}");
+}
+
+#[test]
+fn issue_14_corpus_meshes_keep_no_small_hinged_piece_and_pass_the_check() {
+    use modal_tetra::{corpus, HINGED_DROP_FRACTION};
+    for name in ["teapot", "nonmanifold", "vessel", "animal", "holed_sphere"] {
+        let s = corpus::asset(name).unwrap();
+        let (m, r) = tetrahedralize(&s, &TetOptions { cell: Some(0.01), ..Default::default() }).unwrap();
+        let parts = modal_mesh::face_parts(&m);
+        assert!(parts.hinges.is_empty(), "{name}: hinges left in the output: {:?}", parts.hinges);
+        assert_good(&m, &r);
+        for h in &parts.hinges {
+            let small = h.parts.map(|p| parts.tets[p]).into_iter().min().unwrap();
+            assert!(
+                small as f64 > HINGED_DROP_FRACTION * r.tets as f64,
+                "{name}: a hinged piece of {small} tets of {} was kept at {:?}",
+                r.tets,
+                h.at
+            );
+        }
+        assert_eq!(
+            r.hinged_tets_dropped > 0,
+            r.warnings.iter().any(|w| w.contains("hung on the rest")),
+            "{name}"
+        );
+        let (checked, report) = modal_mesh::check(m).unwrap();
+        // After the check, node-connected parts are the face-connected ones.
+        assert_eq!(modal_mesh::connected_parts(&checked).0, modal_mesh::face_parts(&checked).count, "{name}");
+        assert_eq!(report.parts, modal_mesh::face_parts(&checked).count, "{name}");
+        assert!(modal_mesh::face_parts(&checked).hinges.is_empty() || report.hinge_nodes_split > 0);
+    }
+}
+
+#[test]
+fn issue_14_a_thin_solid_falls_back_to_a_finer_cell_or_names_one() {
+    // A 2 mm plate, 10 cm wide: an explicit 8 mm cell finds nothing inside
+    // and names a cell that works; the default cell (thickness-aware) works.
+    let plate = shapes::cuboid(0.1, 0.1, 0.002);
+    let e = tetrahedralize(&plate, &TetOptions { cell: Some(0.008), ..Default::default() }).unwrap_err();
+    let text = e.to_string();
+    assert!(matches!(e, TetraError::NoVolume { .. }), "{text}");
+    assert!(text.contains("--cell") && text.contains("works"), "{text}");
+    let cell: f64 = text.split("--cell ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    let (_, r) = tetrahedralize(&plate, &TetOptions { cell: Some(cell), ..Default::default() }).unwrap();
+    assert!(r.tets > 0);
 }
