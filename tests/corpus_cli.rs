@@ -161,7 +161,7 @@ fn a_triangle_soup_and_a_non_manifold_pair_of_boxes_give_banks() {
 /// inputs) one clear error line. Prints the time of each run.
 /// `cargo test --release --test corpus_cli -- --ignored --nocapture`
 #[test]
-#[ignore = "the whole corpus at default settings: about a minute in release"]
+#[ignore = "the whole corpus at default settings: many minutes (the vessel makes 120k tets, see BENCHMARKS.md)"]
 fn the_whole_corpus_at_default_settings() {
     let dir = temp_dir();
     for info in ASSETS {

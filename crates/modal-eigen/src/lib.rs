@@ -35,6 +35,6 @@ mod tiled;
 mod types;
 
 pub use factor::Analysis;
-pub use krylov::attainable as residual_bound;
+pub use krylov::{attainable as residual_bound, STALL_RESTARTS};
 pub use solve::{analyze, solve, solve_analyzed};
 pub use types::*;

@@ -77,10 +77,22 @@ pub fn solve_analyzed(
     std::thread::scope(|scope| {
         let worker = scope.spawn(move || {
             pool.install(move || {
-                solve_validated(k, m, rigid_fields, opts, analysis, &mut |p| {
-                    // The receiver lives until this thread ends.
+                // The receiver lives until this thread ends.
+                let mut send = |p: Progress| {
                     let _ = events.send(p);
-                })
+                };
+                let first = solve_validated(k, m, rigid_fields, opts, analysis, false, &mut send);
+                match first {
+                    // A search that stalls or fails without the lower inertia count is redone
+                    // with it: it tells how many near-zero modes (near-mechanisms) lie below the
+                    // band, so the search can be sized for them or aimed past them.
+                    Err(EigenError::Stalled { .. } | EigenError::NoConvergence { .. })
+                        if !counts_below_band(k, m, opts)? =>
+                    {
+                        solve_validated(k, m, rigid_fields, opts, None, true, &mut send)
+                    }
+                    other => other,
+                }
             })
         });
         for event in received {
@@ -97,6 +109,7 @@ fn solve_validated(
     rigid_fields: Option<MatRef<'_, f64>>,
     opts: &EigenOptions,
     analysis: Option<Analysis>,
+    force_count: bool,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<EigenSolution, EigenError> {
     let n = k.nrows();
@@ -154,7 +167,7 @@ fn solve_validated(
     // A band edge far below the top of the spectrum (20 Hz vs MHz) cannot have many modes
     // below it worth a factorization: the upper inertia count then proves completeness of
     // everything below σ' including the modes below f_min that the search converges anyway.
-    let count_below = lam_lo > LOW_EDGE_FRACTION * lam_scale;
+    let count_below = force_count || lam_lo > LOW_EDGE_FRACTION * lam_scale;
     let nu_lo = if count_below {
         stats.factorizations += 1;
         inertia(&mut factor, lam_lo)?
@@ -263,7 +276,8 @@ fn solve_validated(
                 search(f, k, m, defl, &cfg, &enough, &mut early, &mut counters, storage, progress)
             });
             let early = slot.into_inner().and_then(|(sig, r)| r.ok().map(|nu| (sig, nu)));
-            (out?, early)
+            let hint = |e| stall_hint(e, count_below.then_some(elastic_below), opts.min_freq_hz);
+            (out.map_err(hint)?, early)
         };
         known.merge(out.lambdas, out.vectors, out.residuals);
 
@@ -337,6 +351,33 @@ fn solve_validated(
         wanted = nu_hi - found + block;
         missing = Some((sigma_hi, nu_hi - found));
     }
+}
+
+/// Whether [`solve_validated`] counts the eigenvalues below the band without being asked to.
+fn counts_below_band(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    opts: &EigenOptions,
+) -> Result<bool, EigenError> {
+    Ok(hz_to_lambda(opts.min_freq_hz) > LOW_EDGE_FRACTION * spectrum_scale(k, m)?)
+}
+
+/// Says in a stall error why the search stalled and what to change; `below`: the elastic
+/// modes below the band if they were counted.
+fn stall_hint(e: EigenError, below: Option<usize>, min_freq_hz: f64) -> EigenError {
+    let EigenError::Stalled { converged, wanted, restarts, .. } = e else { return e };
+    let hint = match below {
+        Some(b) if b > 0 => format!(
+            "{b} modes besides the rigid-body ones lie below {min_freq_hz} Hz: near-mechanisms (parts joined \
+             by a hinge or a very thin neck) that the search cannot separate; raise the lower band edge above \
+             them, or remesh the thin connections finer"
+        ),
+        Some(_) => "the wanted modes form clusters the search cannot separate; ask for fewer modes or a \
+                    narrower band"
+            .into(),
+        None => "the lowest modes form a cluster the search cannot separate (near-mechanisms?)".into(),
+    };
+    EigenError::Stalled { converged, wanted, restarts, hint }
 }
 
 /// Krylov basis size (columns, excluding the residual block) for `nev` wanted pairs:

@@ -282,6 +282,19 @@ pub enum EigenError {
         /// Wanted.
         wanted: usize,
     },
+    /// A search gained no converged mode for [`crate::STALL_RESTARTS`] restarts in a row
+    /// and was stopped early; `hint` says why and what to change.
+    #[error("eigensolver stalled after {restarts} restarts: {converged} of {wanted} wanted modes converged, none more in the last {} restarts; {hint}", crate::STALL_RESTARTS)]
+    Stalled {
+        /// Converged.
+        converged: usize,
+        /// Wanted.
+        wanted: usize,
+        /// Restarts done over all searches.
+        restarts: usize,
+        /// Why it stalled and what to change (filled in by the driver).
+        hint: String,
+    },
     /// The Sylvester inertia count disagrees with the modes found, even after searching again.
     #[error("inertia check failed: {expected} eigenvalues below the check shift, {found} found")]
     InertiaMismatch {

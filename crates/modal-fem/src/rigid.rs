@@ -25,12 +25,11 @@ pub fn node_parts(mesh: &TetMesh) -> (Vec<usize>, usize) {
     }
     for e in 0..mesh.cells.len() {
         let nodes = mesh.cells.nodes_of(e);
-        let first = root(&mut parent, nodes[0]);
         for &other in &nodes[1..] {
-            let r = root(&mut parent, other);
-            if r != first {
-                let (lo, hi) = (r.min(first), r.max(first));
-                parent[hi] = lo;
+            // Both roots afresh: the previous union may have moved the first node's root.
+            let (a, b) = (root(&mut parent, nodes[0]), root(&mut parent, other));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
             }
         }
     }

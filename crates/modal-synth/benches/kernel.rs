@@ -2,7 +2,8 @@
 //! our f32 SIMD kernel through `ModalVoice` (one thread, and the rayon
 //! chunked path), against (a) naive `exp()·sin()` per sample, (b) a per-mode
 //! biquad resonator (Faust `modeFilter` style, direct form I), and (c) the
-//! scalar f64 complex recurrence. Run: `cargo bench -p modal-synth`.
+//! scalar f64 complex recurrence; and the force-driven path (`DrivenVoice`,
+//! exact first-order hold, f64). Run: `cargo bench -p modal-synth`.
 
 use divan::counter::ItemsCount;
 use divan::Bencher;
@@ -159,6 +160,34 @@ fn scalar_f64_recurrence(bencher: Bencher, n: usize) {
     bencher.counter(ItemsCount::new(n * samples)).bench_local(|| {
         out.iter_mut().for_each(|o| *o = 0.0);
         kernel::render_reference(&mut ur, &mut ui, &pr, &pi, &mut out);
+        divan::black_box(&out);
+    });
+}
+
+/// The force-driven path (`DrivenVoice`, exact first-order hold, f64): one
+/// contact force segment acting over the whole render, a knot per sample.
+#[divan::bench(args = [64, 1024], sample_count = 10)]
+fn driven_force_path(bencher: Bencher, n: usize) {
+    use modal_synth::{DrivenVoice, ForceSegment, ImpactPoint, SynthModel};
+    let samples = samples_for(n, 1 << 22);
+    let iterations = 12;
+    let o = SynthOptions { cull_db: None, ..SynthOptions::default() };
+    let model = std::sync::Arc::new(SynthModel::new(&bank(n)).expect("bench bank"));
+    let mut v = DrivenVoice::from_model(model, o).expect("bench voice");
+    let forces = (0..samples * iterations + 1).map(|k| [0.0, 0.0, (k as f64 * 0.37).sin()]).collect();
+    v.add_segment(ForceSegment {
+        start: 0,
+        oversample: 1,
+        point: ImpactPoint::Position([0.02, 0.02, 0.0]),
+        forces,
+    })
+    .expect("bench segment");
+    let mut out = vec![0.0f32; samples];
+    let mut pos = 0u64;
+    bencher.counter(ItemsCount::new(n * samples)).bench_local(|| {
+        // Past the segment the modes ring freely: the cost is the same.
+        v.render(&mut out, pos);
+        pos += samples as u64;
         divan::black_box(&out);
     });
 }
