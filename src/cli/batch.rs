@@ -1,6 +1,6 @@
 //! `modal precompute-batch`: a manifest of assets → one bank each and a catalogue.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -91,17 +91,37 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
         shard,
     };
     let bar = progress_bar(assets.len() as u64, &selection);
+    // Without a terminal (a Slurm or Kubernetes log) the bar is hidden: one line per asset instead.
+    let log_lines = !std::io::stderr().is_terminal();
     let start = Instant::now();
     let on_event = |event: Event<'_>| match event {
         Event::Started { asset } => bar.set_message(asset.path.clone()),
         Event::Finished { entry, warnings, .. } => {
+            bar.inc(1);
+            // Read before `suspend`, which holds the bar's lock while its closure runs.
+            let (done, total, eta) = (bar.position(), bar.length().unwrap_or(0), bar.eta().as_secs());
             bar.suspend(|| {
                 warnings.iter().for_each(|w| warn(w));
                 if !entry.is_ok() {
                     warn(&format!("{} failed: {}", entry.path, entry.status));
                 }
+                if log_lines {
+                    let how = if !entry.is_ok() {
+                        "failed"
+                    } else if entry.cached {
+                        "reused"
+                    } else {
+                        "solved"
+                    };
+                    eprintln!(
+                        "{selection}[{done}/{total}] {} {how} in {:.1} s; ETA {}:{:02}",
+                        entry.path,
+                        entry.seconds,
+                        eta / 60,
+                        eta % 60
+                    );
+                }
             });
-            bar.inc(1);
         }
     };
     let catalogue = modal_batch::run_batch(&assets, &options, &on_event)?;

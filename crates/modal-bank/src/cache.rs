@@ -6,6 +6,17 @@
 //! cannot be stored). Writes are atomic (temporary file + rename), so
 //! concurrent writers of one key are safe and readers never see partial files.
 //! A damaged entry is reported as [`BankError::CorruptCacheEntry`], never served.
+//!
+//! Shared caches (many processes, several machines, a network file system):
+//! no locks are taken. The temporary file is created in the cache directory
+//! itself with a unique name and flushed (`fsync`) before the rename, and a
+//! rename within one directory is atomic on POSIX file systems, NFS
+//! included, so two writers of one key each publish a complete file (the same
+//! bytes up to the solve timings) and the last rename wins. Whatever still
+//! goes wrong — a torn copy, a crash on a file system without atomic rename,
+//! bit rot, a stale NFS handle — fails the bank's SHA-256 checksum, the key
+//! check or the read, and the caller recomputes and `put`s over it
+//! (`modal-precompute` does).
 
 use crate::fsio::{atomic_write, decode_open_file, open_regular};
 use crate::DeferredBank;
