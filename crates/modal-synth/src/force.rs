@@ -49,7 +49,7 @@ use std::sync::Arc;
 use crate::complex::C64;
 use crate::error::SynthError;
 use crate::model::SynthModel;
-use crate::options::{classify_mode, OutputGain, SynthOptions};
+use crate::options::{classify_mode, SynthOptions};
 use crate::surface::SurfacePoint;
 use crate::voice::{weight, ImpactPoint, ABSOLUTE_FLOOR, BLOCK};
 
@@ -202,29 +202,14 @@ impl DrivenVoice {
                 (v.a[i], v.b[i]) = foh_coefficients(s, 1.0 / fs);
             }
         }
-        match v.opts.gain.clone() {
-            OutputGain::ContactMic { at: Some(p) } => {
-                let hit = v.model.locate(p)?;
-                v.set_mic(&hit);
-            }
-            OutputGain::ContactMic { at: None } => {}
-            OutputGain::RadiationProxy => {
-                let g = v.model.rms_normal_shapes();
-                v.set_gains(&g);
-            }
-            OutputGain::PerMode(g) => {
-                if g.len() != n {
-                    return Err(SynthError::GainCount { got: g.len(), expected: n });
-                }
-                v.set_gains(&g);
-            }
+        if let Some(g) = v.model.initial_gains(&v.opts.gain)? {
+            v.set_gains(&g);
         }
         Ok(v)
     }
 
     fn set_mic(&mut self, p: &SurfacePoint) {
-        let mut g = vec![0.0; self.model.mode_count()];
-        self.model.shapes_dot(p, p.normal, &mut g);
+        let g = self.model.mic_gains(p);
         self.set_gains(&g);
     }
 

@@ -9,6 +9,7 @@
 use std::sync::Arc;
 
 use crate::error::SynthError;
+use crate::options::OutputGain;
 use crate::surface::{node_weights, SurfaceLocator, SurfacePoint};
 use modal_bank::ModeBank;
 use modal_mesh::Surface;
@@ -32,6 +33,31 @@ pub struct SynthModel {
 }
 
 impl SynthModel {
+    /// The per-mode output gains `g_i` that `gain` fixes before any strike;
+    /// `None` for a contact microphone at the first struck point, whose
+    /// gains [`Self::mic_gains`] gives once that point is known.
+    pub(crate) fn initial_gains(&self, gain: &OutputGain) -> Result<Option<Vec<f64>>, SynthError> {
+        match gain {
+            OutputGain::ContactMic { at: Some(p) } => Ok(Some(self.mic_gains(&self.locate(*p)?))),
+            OutputGain::ContactMic { at: None } => Ok(None),
+            OutputGain::RadiationProxy => Ok(Some(self.rms_normal_shapes())),
+            OutputGain::PerMode(g) => {
+                let expected = self.mode_count();
+                if g.len() != expected {
+                    return Err(SynthError::GainCount { got: g.len(), expected });
+                }
+                Ok(Some(g.clone()))
+            }
+        }
+    }
+
+    /// Contact-microphone gains `g_i = φ_i(p)·n(p)` at a surface point.
+    pub(crate) fn mic_gains(&self, p: &SurfacePoint) -> Vec<f64> {
+        let mut g = vec![0.0; self.mode_count()];
+        self.shapes_dot(p, p.normal, &mut g);
+        g
+    }
+
     /// Copies and checks what the synthesizer needs from `bank` (the whole
     /// bank is cloned; [`SynthModel::shared`] avoids the copy).
     pub fn new(bank: &ModeBank) -> Result<SynthModel, SynthError> {

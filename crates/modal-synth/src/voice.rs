@@ -44,7 +44,7 @@ use crate::contact::{half_sine_spectrum, MAX_CONTACT_TIME_S};
 use crate::error::SynthError;
 use crate::kernel::{self, LaneBuf, SimdPath, CHUNK, LANES, TILE};
 use crate::model::SynthModel;
-use crate::options::{classify_mode, Kernel, OutputGain, OutputQuantity, SkipReason, SynthOptions};
+use crate::options::{classify_mode, Kernel, OutputQuantity, SkipReason, SynthOptions};
 use crate::surface::SurfacePoint;
 use modal_bank::ModeBank;
 use rayon::prelude::*;
@@ -294,29 +294,14 @@ impl ModalVoice {
             seg64: Vec::new(),
             opts,
         };
-        match voice.opts.gain.clone() {
-            OutputGain::ContactMic { at: Some(p) } => {
-                let hit = voice.model.locate(p)?;
-                voice.set_mic(&hit);
-            }
-            OutputGain::ContactMic { at: None } => {}
-            OutputGain::RadiationProxy => {
-                let g = voice.model.rms_normal_shapes();
-                voice.set_gains(&g);
-            }
-            OutputGain::PerMode(g) => {
-                if g.len() != n {
-                    return Err(SynthError::GainCount { got: g.len(), expected: n });
-                }
-                voice.set_gains(&g);
-            }
+        if let Some(g) = voice.model.initial_gains(&voice.opts.gain)? {
+            voice.set_gains(&g);
         }
         Ok(voice)
     }
 
     fn set_mic(&mut self, p: &SurfacePoint) {
-        let mut g = vec![0.0; self.model.mode_count()];
-        self.model.shapes_dot(p, p.normal, &mut g);
+        let g = self.model.mic_gains(p);
         self.set_gains(&g);
     }
 
