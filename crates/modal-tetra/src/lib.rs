@@ -4,8 +4,10 @@
 //! multiplies, a unit warning points to `--scale`), possibly with holes,
 //! flipped or inconsistently oriented triangles, duplicate vertices,
 //! degenerate triangles, self-intersections or several parts.
-//! Output: a [`modal_mesh::TetMesh`] of positively oriented 4-node tets with
-//! no unused nodes, plus a [`TetReport`] (quality, volume, surface deviation).
+//! Output: a [`modal_mesh::TetMesh`] of positively oriented tets with no
+//! unused nodes, plus a [`TetReport`] (quality, volume, surface deviation).
+//! By default ([`TetOptions::curved`]) the tets have 10 nodes and the
+//! mid-edge nodes of boundary edges lie on the input surface; otherwise 4.
 //!
 //! Pipeline ([`tetrahedralize`]):
 //! 1. [`diagnose`]: weld, drop degenerates, classify edges, orient triangles
@@ -23,6 +25,9 @@
 //!    output tets are joined by an edge or a vertex only.
 //! 5. Sharp features (module `features`): boundary nodes near sharp input
 //!    edges and corners are moved onto them when quality allows.
+//! 6. Curved boundary (module `curve`): 10-node tets, boundary mid-edge
+//!    nodes moved to the closest surface point, guarded by a Jacobian check
+//!    with a straight fallback per element ([`MIN_JACOBIAN_RATIO`]).
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
 //! [`TetOptions::target_tets`], else h = min(diagonal / 25, 2V/A / 1.5)
@@ -38,6 +43,7 @@
 
 mod bvh;
 pub mod corpus;
+mod curve;
 mod diagnose;
 mod error;
 mod features;
@@ -49,6 +55,7 @@ pub mod shapes;
 mod stuff;
 mod surface;
 
+pub use curve::{MAX_BULGE, MIN_JACOBIAN_RATIO};
 pub use diagnose::{diagnose, SurfaceReport};
 pub use error::TetraError;
 pub use features::{FEATURE_ANGLE_DEG, GUARD_DEG, SNAP_FRACTION};

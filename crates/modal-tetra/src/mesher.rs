@@ -5,6 +5,7 @@ use modal_mesh::{Cells, TetMesh};
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
+use crate::curve::curve;
 use crate::diagnose::repair;
 use crate::features::{features, snap};
 use crate::geom::{area_vector, dihedral_angles_deg, norm, orient6, V3};
@@ -44,6 +45,14 @@ pub struct TetOptions {
     /// Move boundary nodes onto sharp input edges and corners (see
     /// [`crate::FEATURE_ANGLE_DEG`]), keeping the quality bound.
     pub preserve_features: bool,
+    /// Output 10-node tets whose boundary mid-edge nodes lie on the input
+    /// surface (module `curve`; default); `false` gives the 4-node tets.
+    /// The corner tets are the same either way.
+    pub curved: bool,
+    /// Multiplies every element size the other fields give (default 1):
+    /// 2 coarsens the whole mesh by two, ½ refines it (two-level error
+    /// estimates use it).
+    pub size_factor: f64,
 }
 
 impl Default for TetOptions {
@@ -55,6 +64,8 @@ impl Default for TetOptions {
             cells_per_thickness: DEFAULT_CELLS_PER_THICKNESS,
             max_tets: 2_000_000,
             preserve_features: true,
+            curved: true,
+            size_factor: 1.0,
         }
     }
 }
@@ -64,8 +75,14 @@ impl TetOptions {
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
         format!(
-            "tetra=stuffing-v2;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={}",
-            self.cell, self.target_tets, self.cells_per_diagonal, self.cells_per_thickness, self.preserve_features
+            "tetra=stuffing-v3;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};size_factor={}",
+            self.cell,
+            self.target_tets,
+            self.cells_per_diagonal,
+            self.cells_per_thickness,
+            self.preserve_features,
+            self.curved,
+            self.size_factor
         )
     }
 }
@@ -79,16 +96,22 @@ pub struct TetReport {
     pub nodes: usize,
     /// Cell size h used (m).
     pub cell_m: f64,
-    /// Smallest dihedral angle over all tets (degrees).
+    /// Smallest dihedral angle over all (corner) tets (degrees).
     pub min_dihedral_deg: f64,
     /// Largest dihedral angle over all tets (degrees).
     pub max_dihedral_deg: f64,
-    /// Tet mesh volume (m³).
+    /// Tet mesh volume (m³), exact for curved 10-node tets.
     pub volume_m3: f64,
     /// Volume enclosed by the (repaired) input surface (m³).
     pub surface_volume_m3: f64,
-    /// Largest distance from a boundary node of the mesh to the input surface (m).
+    /// Largest distance from a boundary node of the mesh (corner or
+    /// mid-edge) to the input surface (m).
     pub max_surface_deviation_m: f64,
+    /// Boundary mid-edge nodes placed on the input surface (0 when not `curved`).
+    pub curved_edges: usize,
+    /// Elements whose boundary edges were left straight because curving
+    /// them would make det J too small (see `curve::MIN_JACOBIAN_RATIO`).
+    pub straightened_elements: usize,
     /// Zero-volume slivers dropped by the stencils (expected 0).
     pub dropped_degenerate: usize,
     /// Boundary nodes moved onto sharp input edges and corners.
@@ -300,17 +323,28 @@ pub fn tetrahedralize(
     } else {
         0
     };
-    let (min_dihedral_deg, max_dihedral_deg, volume_m3) = quality(&stuffed.nodes, &stuffed.tets);
-    let max_surface_deviation_m = deviation(&stuffed.nodes, &boundary, &bvh);
+    let (min_dihedral_deg, max_dihedral_deg, mut volume_m3) = quality(&stuffed.nodes, &stuffed.tets);
+    let mut max_surface_deviation_m = deviation(&stuffed.nodes, &boundary, &bvh);
+    let (mesh, curved_edges, straightened_elements) = if options.curved {
+        let curved = curve(stuffed.nodes, stuffed.tets, &bvh);
+        volume_m3 = modal_mesh::mesh_volume(&curved.mesh);
+        max_surface_deviation_m =
+            max_surface_deviation_m.max(deviation(&curved.mesh.nodes, &curved.boundary_mids, &bvh));
+        (curved.mesh, curved.curved_edges, curved.straightened_elements)
+    } else {
+        (TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() }, 0, 0)
+    };
     let report = TetReport {
-        tets: stuffed.tets.len(),
-        nodes: stuffed.nodes.len(),
+        tets: mesh.cells.len(),
+        nodes: mesh.nodes.len(),
         cell_m: h,
         min_dihedral_deg,
         max_dihedral_deg,
         volume_m3,
         surface_volume_m3: repaired.report.enclosed_volume_m3,
         max_surface_deviation_m,
+        curved_edges,
+        straightened_elements,
         dropped_degenerate: stuffed.dropped,
         feature_nodes_snapped,
         hinged_pieces_dropped: hinged.pieces,
@@ -318,11 +352,22 @@ pub fn tetrahedralize(
         hinges_split: hinged.split,
         warnings: warnings.into_iter().chain(hinged.warnings).collect(),
     };
-    let mesh = TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() };
     Ok((mesh, report))
 }
 
 fn cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -> Result<f64, TetraError> {
+    let positive = |name: &'static str, x: f64| {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(TetraError::InvalidOption { name, reason: format!("{x} is not a positive finite number") })
+        }
+    };
+    let factor = positive("size_factor", options.size_factor)?;
+    Ok(factor * base_cell_size(options, diagonal, volume, area)?)
+}
+
+fn base_cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -> Result<f64, TetraError> {
     let positive = |name: &'static str, x: f64| {
         if x.is_finite() && x > 0.0 {
             Ok(x)

@@ -83,7 +83,16 @@ fn options_control_resolution_and_guard_size() {
     }
     let e = tetrahedralize(&s, &TetOptions { target_tets: Some(0), ..Default::default() }).unwrap_err();
     assert!(matches!(e, TetraError::InvalidOption { .. }));
+    let half = tetrahedralize(&s, &TetOptions { cell: Some(0.02), size_factor: 0.5, ..Default::default() })
+        .unwrap()
+        .1;
+    assert_eq!(half.cell_m, 0.01);
+    assert!(half.tets > 6 * coarse.tets, "{half:?} vs {coarse:?}");
+    let e = tetrahedralize(&s, &TetOptions { size_factor: 0.0, ..Default::default() }).unwrap_err();
+    assert!(matches!(e, TetraError::InvalidOption { name: "size_factor", .. }), "{e}");
     let a = TetOptions::default().cache_key_fields();
+    assert_ne!(a, TetOptions { size_factor: 0.5, ..Default::default() }.cache_key_fields());
+    assert_ne!(a, TetOptions { curved: false, ..Default::default() }.cache_key_fields());
     let b = TetOptions { cell: Some(0.01), ..Default::default() }.cache_key_fields();
     assert_ne!(a, b);
 }
