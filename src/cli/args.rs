@@ -240,7 +240,7 @@ pub struct PrecomputeArgs {
     /// until the lowest --accuracy-modes modes are estimated within PCT percent (or the
     /// memory guard stops it, saying what was reached); `off`: one solve, no estimate.
     /// An explicit --cell is kept (estimate only). Tet mesh files get no estimate.
-    #[arg(long, value_name = "PCT|off", default_value = "1", value_parser = parse_accuracy)]
+    #[arg(long, value_name = "PCT|off", default_value = "1", value_parser = parse_accuracy, allow_negative_numbers = true)]
     pub accuracy: Accuracy,
     /// The --accuracy target applies to the lowest N modes (all modes get an estimate).
     #[arg(long, value_name = "N", default_value_t = 10)]

@@ -160,7 +160,9 @@ impl BankJson {
             writeln!(out)?;
         }
         match &self.error_estimate_method {
-            Some(method) => writeln!(out, "error %: estimated discretization error of the frequency ({method})")?,
+            Some(method) => {
+                writeln!(out, "error %: estimated discretization error of the frequency ({method})")?
+            }
             None => writeln!(out, "error %: no estimate in this bank (prescribed tet mesh or older bank)")?,
         }
         let t = &self.timings_s;

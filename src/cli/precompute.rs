@@ -59,10 +59,10 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     request.max_freq_hz = args.max_freq;
     request.fix_box = args.fix_box;
     request.threads = args.threads;
-    request.accuracy = args.accuracy.0.map(|target_pct| modal_precompute::AccuracyTarget {
-        target_pct,
-        modes: args.accuracy_modes,
-    });
+    request.accuracy = args
+        .accuracy
+        .0
+        .map(|target_pct| modal_precompute::AccuracyTarget { target_pct, modes: args.accuracy_modes });
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
     let spinner = Spinner::new("starting");
     let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| {

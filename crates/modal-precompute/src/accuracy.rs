@@ -107,10 +107,12 @@ pub fn estimate(fine: &ModeBank, coarse: &ModeBank, fine_dofs: usize, coarse_dof
         let shared = |j: &usize| mac[i][*j] >= SHARED_MAC && within_window(f, coarse.frequencies_hz[*j]);
         let diff = match *m {
             Some(j) if mac[i][j] >= CLEAR_MAC => Some((coarse.frequencies_hz[j] - f).abs()),
-            Some(j) => (0..coarse.frequencies_hz.len())
-                .filter(shared)
-                .map(|k| (coarse.frequencies_hz[k] - f).abs())
-                .fold(Some((coarse.frequencies_hz[j] - f).abs()), |acc, d| acc.map(|a| a.max(d))),
+            Some(j) => Some(
+                (0..coarse.frequencies_hz.len())
+                    .filter(shared)
+                    .map(|k| (coarse.frequencies_hz[k] - f).abs())
+                    .fold((coarse.frequencies_hz[j] - f).abs(), f64::max),
+            ),
             None => None,
         };
         best_mac.push(m.map_or(0.0, |j| mac[i][j]));
@@ -140,7 +142,8 @@ pub fn mac_matrix(fine: &ModeBank, coarse: &ModeBank) -> Vec<Vec<f64>> {
         nodes.flat_map(|k| bank.shape_at(mode, k).map(f64::from)).collect()
     };
     let fine_vecs: Vec<Vec<f64>> = (0..nf).map(|i| gather(fine, i, &mut samples.iter().copied())).collect();
-    let coarse_vecs: Vec<Vec<f64>> = (0..nc).map(|j| gather(coarse, j, &mut partner.iter().copied())).collect();
+    let coarse_vecs: Vec<Vec<f64>> =
+        (0..nc).map(|j| gather(coarse, j, &mut partner.iter().copied())).collect();
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     let fine_norm: Vec<f64> = fine_vecs.iter().map(|a| dot(a, a)).collect();
     let coarse_norm: Vec<f64> = coarse_vecs.iter().map(|b| dot(b, b)).collect();
@@ -173,7 +176,9 @@ pub fn match_modes(mac: &[Vec<f64>], fine_hz: &[f64], coarse_hz: &[f64]) -> Vec<
             }
         }
     }
-    pairs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)).then(a.3.cmp(&b.3)));
+    pairs.sort_by(|a, b| {
+        b.0.total_cmp(&a.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)).then(a.3.cmp(&b.3))
+    });
     let mut fine_of = vec![None; mac.len()];
     let mut coarse_used = vec![false; coarse_hz.len()];
     for (_, _, i, j) in pairs {

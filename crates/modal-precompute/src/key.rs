@@ -41,7 +41,8 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
     // The accuracy target chooses the discretization of a surface mesh (and adds the
     // estimate); a prescribed tet mesh is solved as it is. Absent: the key is unchanged.
     if let (Some(a), true) = (&request.accuracy, crate::levels::remeshable(&request.source)) {
-        key = key.add_str("accuracy", &format!("{}:{}:{}", crate::levels::LEVELS_VERSION, a.target_pct, a.modes));
+        key = key
+            .add_str("accuracy", &format!("{}:{}:{}", crate::levels::LEVELS_VERSION, a.target_pct, a.modes));
     }
     Ok(key.finish())
 }

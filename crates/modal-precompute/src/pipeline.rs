@@ -81,7 +81,10 @@ impl Request {
         }
         if let Some(a) = &self.accuracy {
             if !(a.target_pct.is_finite() && a.target_pct > 0.0) {
-                return invalid(format!("the accuracy target must be a positive percentage, got {}", a.target_pct));
+                return invalid(format!(
+                    "the accuracy target must be a positive percentage, got {}",
+                    a.target_pct
+                ));
             }
             if a.modes == 0 {
                 return invalid("the accuracy target must apply to at least one mode".into());
