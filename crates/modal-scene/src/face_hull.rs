@@ -152,7 +152,12 @@ impl PointQuery for FaceHull {
 }
 
 impl RayCast for FaceHull {
-    fn cast_local_ray_and_get_normal(&self, ray: &Ray, max_toi: Real, solid: bool) -> Option<RayIntersection> {
+    fn cast_local_ray_and_get_normal(
+        &self,
+        ray: &Ray,
+        max_toi: Real,
+        solid: bool,
+    ) -> Option<RayIntersection> {
         self.poly.cast_local_ray_and_get_normal(ray, max_toi, solid)
     }
 }
@@ -210,7 +215,12 @@ impl Shape for FaceHull {
         Some((self as &dyn PolygonalFeatureMap, 0.0))
     }
 
-    fn feature_normal_at_point(&self, subshape: SubShapeId, feature: FeatureId, point: Vector) -> Option<Vector> {
+    fn feature_normal_at_point(
+        &self,
+        subshape: SubShapeId,
+        feature: FeatureId,
+        point: Vector,
+    ) -> Option<Vector> {
         self.poly.feature_normal_at_point(subshape, feature, point)
     }
 }
@@ -250,7 +260,8 @@ mod tests {
         // Tilted: the deepest vertex is chosen.
         let tilted = Vector::new(0.2, -1.0, 0.9).normalize();
         let chosen = spanning_quad(&pts, down, tilted);
-        let deepest = (0..pts.len()).max_by(|&a, &b| pts[a].dot(tilted).total_cmp(&pts[b].dot(tilted))).unwrap();
+        let deepest =
+            (0..pts.len()).max_by(|&a, &b| pts[a].dot(tilted).total_cmp(&pts[b].dot(tilted))).unwrap();
         assert!(chosen.contains(&deepest), "{chosen:?} lacks {deepest}");
         assert!(chosen.windows(2).all(|w| w[0] < w[1]));
         // Small faces are kept whole.
@@ -267,8 +278,13 @@ mod tests {
         let floor = world.bodies.insert(RigidBodyBuilder::fixed());
         let half = ColliderBuilder::halfspace(rapier3d::na::Unit::new_unchecked(Vector::Y));
         world.colliders.insert_with_parent(half, floor, &mut world.bodies);
-        let body = world.bodies.insert(RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.0031, 0.0)));
-        world.colliders.insert_with_parent(ColliderBuilder::new(shape).density(7800.0), body, &mut world.bodies);
+        let body =
+            world.bodies.insert(RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.0031, 0.0)));
+        world.colliders.insert_with_parent(
+            ColliderBuilder::new(shape).density(7800.0),
+            body,
+            &mut world.bodies,
+        );
         for _ in 0..1000 {
             world.step();
         }

@@ -58,7 +58,12 @@ fn a_flat_thin_disc_rests_on_the_floor() {
     for collider in ["hull", "auto", "decomposition"] {
         // Set down flat, at rest, 0.1 mm above the floor.
         let c = final_centre(collider, 0.0, 1e-4);
-        assert!((c[1] - 0.5 * T).abs() < 3e-4, "{collider}: flat disc's centre at y = {} (want {})", c[1], T / 2.0);
+        assert!(
+            (c[1] - 0.5 * T).abs() < 3e-4,
+            "{collider}: flat disc's centre at y = {} (want {})",
+            c[1],
+            T / 2.0
+        );
         // Set down on its rim tilted 25°: it falls flat and rests there
         // (with parry's first-4-vertices contact polygon it ended 3 cm
         // below the floor).
