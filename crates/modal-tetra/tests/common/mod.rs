@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use modal_mesh::{Cells, TetMesh};
-use modal_tetra::{dihedral_angles_deg, TetReport, TriSurface, DIHEDRAL_BOUNDS_DEG};
+use modal_tetra::{
+    dihedral_angles_deg, TetReport, TriSurface, DIHEDRAL_BOUNDS_DEG, GRADED_DIHEDRAL_BOUNDS_DEG,
+};
 
 /// Checks the output contract of `tetrahedralize` with `modal_mesh::check`
 /// (independent code) and the dihedral-angle bounds on every tet.
@@ -21,7 +23,12 @@ pub fn assert_good(mesh: &TetMesh, report: &TetReport) {
             assert!(report.max_surface_deviation_m.is_finite());
         }
     }
-    let (lo, hi) = DIHEDRAL_BOUNDS_DEG;
+    // Graded meshes (background refined below the lattice cell) have their own bounds.
+    let (lo, hi) = if report.min_cell_m < 0.8 * report.cell_m {
+        GRADED_DIHEDRAL_BOUNDS_DEG
+    } else {
+        DIHEDRAL_BOUNDS_DEG
+    };
     for e in 0..mesh.cells.len() {
         let t = mesh.cells.corners(e);
         for a in dihedral_angles_deg(t.map(|i| mesh.nodes[i])) {
