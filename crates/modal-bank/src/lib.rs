@@ -41,7 +41,7 @@ pub use vtu::{export_vtu, export_vtu_file, mode_array_name};
 pub use damping::rayleigh;
 pub use deferred::DeferredBank;
 pub use error::BankError;
-pub use fsio::write_file_atomically;
 pub use format::{FORMAT_NAME, FORMAT_VERSION, OLDEST_READABLE_VERSION};
+pub use fsio::write_file_atomically;
 pub use radiation::{ModeTransfer, RadiationTable};
 pub use types::*;
