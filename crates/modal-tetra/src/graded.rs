@@ -315,6 +315,6 @@ mod tests {
                     .fold(0.0, f64::max)
             })
             .fold(f64::INFINITY, f64::min);
-        assert!(smallest <= 0.15 && smallest >= 0.0625 - 1e-12, "{smallest}");
+        assert!((0.0625 - 1e-12..=0.15).contains(&smallest), "{smallest}");
     }
 }
