@@ -17,11 +17,14 @@
 //! `(½ − K − αN) p = −(L + α(½ + K')) q` with `α = i/k`, which has a
 //! unique solution at every `k > 0` because `Im α ≠ 0`.
 //!
-//! Discretisation: piecewise-constant `p`, `q` on flat panels, collocation
-//! at panel centroids, dense complex LU with partial pivoting (faer,
-//! sequential, so the result does not depend on the thread count). Rows are
-//! assembled independently in parallel (rayon), each by one thread in a
-//! fixed order: bit-identical across thread counts.
+//! Discretisation: piecewise-constant `q` on flat panels; `p` piecewise
+//! constant on the panels or on clusters of panels ([`crate::cluster`]:
+//! fewer unknowns where the wavelength allows, every panel still
+//! integrated exactly as before), collocation at one panel centroid per
+//! cluster, dense complex LU with partial pivoting (faer, sequential, so
+//! the result does not depend on the thread count). Rows are assembled
+//! independently in parallel (rayon), each by one thread in a fixed order:
+//! bit-identical across thread counts.
 
 use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -29,6 +32,7 @@ use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::{Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
+use crate::cluster::Clusters;
 use crate::error::RadiationError;
 use crate::geometry::BoundaryMesh;
 use crate::kernels::Kernels;
@@ -147,6 +151,23 @@ pub fn solve(
     velocities: &[Vec<c64>],
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
+    solve_clustered(mesh, &Clusters::identity(mesh.len()), air, frequency_hz, velocities, formulation)
+}
+
+/// [`solve`] with the pressure constant on each cluster of `clusters` (one
+/// unknown and one collocation point per cluster); the returned fields
+/// hold the pressure per panel (its cluster's value).
+pub fn solve_clustered(
+    mesh: &BoundaryMesh,
+    clusters: &Clusters,
+    air: Air,
+    frequency_hz: f64,
+    velocities: &[Vec<c64>],
+    formulation: Formulation,
+) -> Result<Vec<SurfaceField>, RadiationError> {
+    if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
+        return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
+    }
     air.validate()?;
     if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
         return Err(RadiationError::BadFrequency(frequency_hz));
@@ -161,31 +182,33 @@ pub fn solve(
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
-    let (mut at, mut rhs) = assemble(mesh, k, formulation, velocities, iwr);
-    let pressures =
-        lu_solve_transposed(&mut at, n, &mut rhs, nrhs).ok_or(RadiationError::Singular { frequency_hz })?;
+    let (mut at, mut rhs) = assemble(mesh, clusters, k, formulation, velocities, iwr);
+    let pressures = lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs)
+        .ok_or(RadiationError::Singular { frequency_hz })?;
     Ok((0..nrhs)
         .map(|f| SurfaceField {
             frequency_hz,
             wavenumber: k,
             air,
-            pressure: pressures.col(f).iter().copied().collect(),
+            pressure: clusters.of_panel.iter().map(|&c| pressures[(c, f)]).collect(),
             normal_velocity: velocities[f].clone(),
         })
         .collect())
 }
 
-/// Row `i` of the system matrix `A` is stored as column `i` of `at`
-/// (column-major `n × n`), i.e. `at = Aᵀ`. The right-hand sides come back
-/// row-major `n × nrhs`.
+/// Row `i` (cluster `i`'s collocation point) of the system matrix `A` is
+/// stored as column `i` of `at` (column-major `n × n`, `n` clusters), i.e.
+/// `at = Aᵀ`; entry `(i, c)` sums the integrals over the panels of cluster
+/// `c`. The right-hand sides come back row-major `n × nrhs`.
 fn assemble(
     mesh: &BoundaryMesh,
+    clusters: &Clusters,
     k: f64,
     formulation: Formulation,
     velocities: &[Vec<c64>],
     iwr: c64,
 ) -> (Vec<c64>, Vec<c64>) {
-    let n = mesh.len();
+    let n = clusters.len();
     let nrhs = velocities.len();
     let alpha = match formulation {
         Formulation::BurtonMiller => c64::new(0.0, 1.0 / k),
@@ -196,15 +219,16 @@ fn assemble(
     let mut at = vec![zero; n * n];
     let mut rhs = vec![zero; n * nrhs];
     at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
-        let pi = &mesh.panels[i];
+        let ci = clusters.collocation[i];
+        let pi = &mesh.panels[ci];
         for (j, pj) in mesh.panels.iter().enumerate() {
-            let ints = if i == j {
+            let ints = if ci == j {
                 kern.self_integrals(mesh, pj)
             } else {
                 kern.panel(mesh, pj, pi.centroid, pi.normal)
             };
-            let half = if i == j { 0.5 } else { 0.0 };
-            row[j] = c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g;
+            let half = if ci == j { 0.5 } else { 0.0 };
+            row[clusters.of_panel[j]] += c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g;
             // −(L + α(½ + K')) q_j
             let op = -(ints.g + alpha * (ints.dg_dnx + half));
             for (f, v) in velocities.iter().enumerate() {

@@ -9,12 +9,12 @@ use faer::c64;
 use modal_radiation::special::{
     lm_index, spherical_hankel, spherical_hankel_derivative, spherical_harmonics,
 };
-use modal_radiation::{multipole, shapes, solve, Air, BoundaryMesh, Formulation, SurfaceField};
+use modal_radiation::{multipole, solve, Air, BoundaryMesh, Formulation, SurfaceField};
 
 const A: f64 = 0.1;
 
-fn sphere(subdiv: usize) -> BoundaryMesh {
-    let (v, t) = shapes::icosphere(subdiv);
+fn sphere(subdiv: u32) -> BoundaryMesh {
+    let (v, t) = modal_mesh::icosphere(subdiv);
     BoundaryMesh::new(v.iter().map(|p| p.map(|x| A * x)).collect(), &t).unwrap()
 }
 
@@ -176,7 +176,7 @@ fn spheroidal_patterns_radiate_as_one_multipole_within_half_a_db() {
 /// An ellipsoid (semi-axes 1.5a, a, 0.7a) from the icosphere: mirror
 /// symmetric in each coordinate plane.
 fn ellipsoid() -> BoundaryMesh {
-    let (v, t) = shapes::icosphere(3);
+    let (v, t) = modal_mesh::icosphere(3);
     BoundaryMesh::new(v.iter().map(|p| [1.5 * A * p[0], A * p[1], 0.7 * A * p[2]]).collect(), &t).unwrap()
 }
 
