@@ -34,8 +34,8 @@ use rayon::prelude::*;
 
 use crate::cluster::Clusters;
 use crate::error::RadiationError;
-use crate::geometry::BoundaryMesh;
-use crate::kernels::Kernels;
+use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
+use crate::kernels::{Kernels, PanelIntegrals};
 
 /// Properties of the air.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -196,10 +196,77 @@ pub fn solve_clustered(
         .collect())
 }
 
-/// Row `i` (cluster `i`'s collocation point) of the system matrix `A` is
-/// stored as column `i` of `at` (column-major `n × n`, `n` clusters), i.e.
-/// `at = Aᵀ`; entry `(i, c)` sums the integrals over the panels of cluster
-/// `c`. The right-hand sides come back row-major `n × nrhs`.
+/// A cluster seen as a test region: its panels with area weights, its
+/// area-weighted centre and normal, and its radius about the centre.
+struct TestRegion {
+    members: Vec<(usize, f64)>,
+    centre: [f64; 3],
+    normal: [f64; 3],
+    radius: f64,
+}
+
+fn test_regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<TestRegion> {
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); clusters.len()];
+    for (p, &c) in clusters.of_panel.iter().enumerate() {
+        members[c].push(p);
+    }
+    members
+        .into_iter()
+        .map(|m| {
+            let area: f64 = m.iter().map(|&p| mesh.panels[p].area).sum();
+            let mean = |f: &dyn Fn(usize) -> [f64; 3]| {
+                [0, 1, 2].map(|k| m.iter().map(|&p| mesh.panels[p].area * f(p)[k]).sum::<f64>() / area)
+            };
+            let centre = mean(&|p| mesh.panels[p].centroid);
+            let n = mean(&|p| mesh.panels[p].normal);
+            let len = norm(n);
+            let radius = m
+                .iter()
+                .map(|&p| norm(sub(mesh.panels[p].centroid, centre)) + mesh.panels[p].diameter)
+                .fold(0.0, f64::max);
+            let members = m.iter().map(|&p| (p, mesh.panels[p].area / area)).collect();
+            TestRegion { members, centre, normal: n.map(|x| x / len), radius }
+        })
+        .collect()
+}
+
+/// Panels closer than this many (cluster radius + panel diameter) to a
+/// cluster's centre are tested at every member centroid; farther ones at
+/// the cluster's centre alone (the mean of a smooth kernel over the
+/// cluster, to second order in its size).
+pub const CLUSTER_NEAR_RATIO: f64 = 1.5;
+
+/// Panels farther than this many diameters from the point (and with
+/// `k·h ≤ 1`) are integrated by their centroid alone: relative error
+/// `O((h/r)²)` of the smooth kernel, below 1 % at this ratio.
+pub const FAR_POINT_RATIO: f64 = 8.0;
+
+/// The four panel integrals of `panel` seen from `x`: one centroid point
+/// when far ([`FAR_POINT_RATIO`]), the adaptive rule otherwise.
+fn integrals(
+    kern: &Kernels,
+    mesh: &BoundaryMesh,
+    panel: &Panel,
+    x: [f64; 3],
+    nx: [f64; 3],
+) -> PanelIntegrals {
+    let d = sub(panel.centroid, x);
+    let far = FAR_POINT_RATIO * panel.diameter;
+    if dot(d, d) > far * far && kern.k() * panel.diameter <= 1.0 {
+        kern.point(x, nx, panel.centroid, panel.normal, panel.area)
+    } else {
+        kern.panel(mesh, panel, x, nx)
+    }
+}
+
+/// Row `i` (cluster `i`) of the system matrix `A` is stored as column `i`
+/// of `at` (column-major `n × n`, `n` clusters), i.e. `at = Aᵀ`. The
+/// equation of a cluster is the area-weighted mean of the collocation
+/// equations at its panels' centroids (each balanced about its own panel,
+/// which a single off-centre point of the hypersingular equation is not);
+/// entry `(i, c)` sums the integrals over the panels of cluster `c`. A
+/// single panel per cluster is plain centroid collocation. The right-hand
+/// sides come back row-major `n × nrhs`.
 fn assemble(
     mesh: &BoundaryMesh,
     clusters: &Clusters,
@@ -216,21 +283,35 @@ fn assemble(
     };
     let kern = Kernels::new(k);
     let zero = c64::new(0.0, 0.0);
+    let regions = test_regions(mesh, clusters);
     let mut at = vec![zero; n * n];
     let mut rhs = vec![zero; n * nrhs];
     at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
-        let ci = clusters.collocation[i];
-        let pi = &mesh.panels[ci];
+        let region = &regions[i];
+        let single = region.members.len() == 1;
         for (j, pj) in mesh.panels.iter().enumerate() {
-            let ints = if ci == j {
-                kern.self_integrals(mesh, pj)
+            let near = single
+                || norm(sub(pj.centroid, region.centre)) < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter);
+            let (mut a, mut op) = (zero, zero);
+            if near {
+                for &(t, w) in &region.members {
+                    let pt = &mesh.panels[t];
+                    let ints = if t == j {
+                        kern.self_integrals(mesh, pj)
+                    } else {
+                        integrals(&kern, mesh, pj, pt.centroid, pt.normal)
+                    };
+                    let half = if t == j { 0.5 } else { 0.0 };
+                    a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
+                    // −(L + α(½ + K')) q_j
+                    op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
+                }
             } else {
-                kern.panel(mesh, pj, pi.centroid, pi.normal)
-            };
-            let half = if ci == j { 0.5 } else { 0.0 };
-            row[clusters.of_panel[j]] += c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g;
-            // −(L + α(½ + K')) q_j
-            let op = -(ints.g + alpha * (ints.dg_dnx + half));
+                let ints = integrals(&kern, mesh, pj, region.centre, region.normal);
+                a = -ints.dg_dny - alpha * ints.d2g;
+                op = -(ints.g + alpha * ints.dg_dnx);
+            }
+            row[clusters.of_panel[j]] += a;
             for (f, v) in velocities.iter().enumerate() {
                 b[f] += op * (v[j] * iwr);
             }

@@ -14,10 +14,10 @@
 //! `a_lm = ik ∫_S [p(y) ∂/∂n_y ψ_lm*(y) − q(y) ψ_lm*(y)] dS_y`,
 //! `ψ_lm(y) = j_l(k|y − c|) Y_l^m(ŷ)` (regular spherical waves),
 //!
-//! integrated with the 7-point rule on every panel: O(N·L²) work for N
-//! panels and degree L. `∂ψ/∂n` is a central difference along the normal
-//! with step `δ = 10⁻⁴ min(1/k, R)` (truncation ≈ 10⁻⁸ relative,
-//! rounding ≈ 10⁻¹²).
+//! integrated with the 3-point rule (degree 2) on every panel: O(N·L²)
+//! work for N panels and degree L. `ψ` and `∂ψ/∂n` come from the two
+//! points `y ± δn`, `δ = 10⁻⁴ min(1/k, R)`: their mean and central
+//! difference (truncation ≈ 10⁻⁸ relative, rounding ≈ 10⁻¹²).
 //!
 //! The order `L` is the smallest with the tail's mean-square pressure on
 //! the sphere `r_fit = 2R`, `Σ_{l>L} Σ_m |a_lm h_l(k r_fit)|²` (Parseval),
@@ -32,7 +32,7 @@ use faer::c64;
 
 use crate::bem::{Air, SurfaceField};
 use crate::geometry::{norm, sub, BoundaryMesh};
-use crate::quadrature::TRIANGLE_7;
+use crate::quadrature::TRIANGLE_3;
 use crate::special::{lm_index, spherical_bessel_j, spherical_hankel, spherical_harmonics};
 
 /// Extra degrees above `kR` in the fit (the near-field tail at
@@ -143,18 +143,17 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
             for (o, p) in chunk.iter().enumerate() {
                 let j = c * CHUNK + o;
                 let [a, b, cc] = p.corners.map(|i| mesh.vertices[i]);
-                for (bary, w) in TRIANGLE_7 {
+                for (bary, w) in TRIANGLE_3 {
                     let y = [0, 1, 2].map(|q| bary[0] * a[q] + bary[1] * b[q] + bary[2] * cc[q]);
-                    let psi = regular(y);
                     let plus = regular([0, 1, 2].map(|q| y[q] + delta * p.normal[q]));
                     let minus = regular([0, 1, 2].map(|q| y[q] - delta * p.normal[q]));
                     let wa = w * p.area;
                     for (f, field) in fields.iter().enumerate() {
                         let pw = field.pressure[j] * (wa / (2.0 * delta));
-                        let qw = field.dpdn(j) * wa;
+                        let qw = field.dpdn(j) * (0.5 * wa);
                         let out = &mut acc[f * ncoef..(f + 1) * ncoef];
                         for i in 0..ncoef {
-                            out[i] += pw * (plus[i] - minus[i]) - qw * psi[i];
+                            out[i] += pw * (plus[i] - minus[i]) - qw * (plus[i] + minus[i]);
                         }
                     }
                 }
