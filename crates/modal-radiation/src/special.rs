@@ -187,15 +187,11 @@ mod tests {
         for &x in &[1e-4, 0.01, 0.3] {
             let j = spherical_bessel_j(40, x);
             let mut dfact = 1.0f64;
-            for l in 0..=40usize {
+            for (l, jl) in j.iter().enumerate() {
                 dfact *= (2 * l + 1) as f64;
                 let series = x.powi(l as i32) / dfact * (1.0 - x * x / (2.0 * (2 * l + 3) as f64));
                 let rel = x.powi(4) / ((2 * l + 3) as f64 * (2 * l + 5) as f64);
-                assert!(
-                    (j[l] - series).abs() <= (rel + 1e-12) * series.abs(),
-                    "l={l} x={x}: {} vs {series}",
-                    j[l]
-                );
+                assert!((jl - series).abs() <= (rel + 1e-12) * series.abs(), "l={l} x={x}: {jl} vs {series}");
             }
         }
         // A zero of j_0 (x = π): normalized through j_1.
