@@ -114,10 +114,16 @@ fn fictitious_frequency_ka_pi_is_solved_by_burton_miller_and_not_by_the_cbie() {
     let (level, phase) = errors(&mesh, &bm, 2.5 * A, want);
     assert!(level < 0.25 && phase < 0.02, "Burton–Miller: {level} dB, {phase} rad");
     // The conventional equation is (nearly) singular here: same mesh, far
-    // worse (measured −1.1 dB; it is < 0.1 dB at ka = 3).
+    // worse (measured 0.64 dB with far panels by centroid, 1.1 dB with the
+    // 7-point rule everywhere: the size of the error depends on how close to
+    // singular the discrete system lands; it is < 0.1 dB at ka = 3).
     let cbie = solve_one(&mesh, std::f64::consts::PI, v, Formulation::Conventional);
     let (bad_level, _) = errors(&mesh, &cbie, 2.5 * A, want);
-    assert!(bad_level > 0.8, "CBIE at its fictitious frequency: only {bad_level} dB off");
+    eprintln!("ka = π: Burton–Miller {level:.3} dB, CBIE {bad_level:.3} dB");
+    assert!(
+        bad_level > 0.5 && bad_level > 2.5 * level,
+        "CBIE at its fictitious frequency: only {bad_level} dB off (Burton–Miller {level} dB)"
+    );
 }
 
 #[test]
