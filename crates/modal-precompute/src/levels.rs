@@ -31,7 +31,7 @@ use crate::{is_surface_file, MeshSource, PrecomputeError, Request, Stage};
 
 /// Part of the cache key of banks made to an accuracy target; bump when the levels
 /// or the estimate change.
-pub const LEVELS_VERSION: &str = "levels-2";
+pub const LEVELS_VERSION: &str = "levels-3";
 
 /// Element sizes of the coarse level relative to the fine one.
 pub const COARSE_FACTOR: f64 = 1.5;
