@@ -187,7 +187,7 @@ fn measure(exe: &Path, dir: &Path, input: &str, out: &str, extra: &[&str]) -> Re
         .ok()
         .and_then(|t| t.lines().last()?.trim().parse::<u64>().ok())
         .map(|kb| kb * 1024);
-    let bank = modal_bank::ModeBank::load(&dir.join(out)).expect("bank loads");
+    let bank = modal_bank::ModeBank::load(dir.join(out)).expect("bank loads");
     Ok(Measured { wall_s, peak_rss, bank })
 }
 
@@ -201,7 +201,7 @@ fn measure_once(exe: &Path, dir: &Path, input: &str, out: &str, extra: &[&str]) 
         if let Some(e) = r["error"].as_str() {
             return Err(e.to_string());
         }
-        if let Ok(bank) = modal_bank::ModeBank::load(&dir.join(out)) {
+        if let Ok(bank) = modal_bank::ModeBank::load(dir.join(out)) {
             return Ok(Measured {
                 wall_s: r["wall_s"].as_f64().unwrap_or(f64::NAN),
                 peak_rss: r["peak_rss"].as_u64(),
@@ -270,9 +270,9 @@ fn compare(
     use modal_precompute::accuracy::{mac_matrix, match_modes};
     let m = match_modes(&mac_matrix(run, finest), &run.frequencies_hz, &finest.frequencies_hz);
     let (mut rows, mut worst, mut failures) = (Vec::new(), 0.0_f64, Vec::new());
-    for i in 0..run.mode_count().min(COMPARED_MODES) {
+    for (i, &partner) in m.iter().enumerate().take(COMPARED_MODES) {
         let f = run.frequencies_hz[i];
-        let Some(j) = m[i] else {
+        let Some(j) = partner else {
             failures.push(format!("{name}: mode {} ({f:.1} Hz) not matched to the reference", i + 1));
             continue;
         };
