@@ -42,7 +42,7 @@ fn pressures(m: &Value) -> Vec<f64> {
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
-    if a.len() < 6 || (a.len() - 3) % 3 != 0 {
+    if a.len() < 6 || !(a.len() - 3).is_multiple_of(3) {
         eprintln!("usage: pareto OUT.png REF.json REF.err RUN.json RUN.err LABEL [RUN.json RUN.err LABEL …]");
         std::process::exit(2);
     }
