@@ -12,7 +12,7 @@ mod common;
 
 use std::sync::Arc;
 
-use modal_synth::{C64, Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions};
+use modal_synth::{Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions, C64};
 
 /// `m_i(t) = c_i e^{(α_i + iΩ_i) t}`, or `cos(Ω_i t + φ_i)` (a dipole seen
 /// from a body spinning at Ω_i).
@@ -141,10 +141,8 @@ fn a_spinning_dipole_follows_its_cosine_within_the_interpolation_error() {
     let bank = bank();
     let gains = vec![1.0, 0.7, 0.4, 0.2];
     let spin = 2.0 * std::f64::consts::PI * 2.0; // 2 rev/s
-    let src = Source {
-        kind: Kind::Cosine,
-        params: (0..4).map(|i| (C64::ZERO, 0.3 * i as f64, spin)).collect(),
-    };
+    let src =
+        Source { kind: Kind::Cosine, params: (0..4).map(|i| (C64::ZERO, 0.3 * i as f64, spin)).collect() };
     let want = reference(&bank, &gains, &src);
     let got = render(&bank, opts(gains.clone(), OutputQuantity::Velocity, Kernel::Auto), Some(Arc::new(src)));
     let (err, peak) = max_err(&got, &want);
