@@ -236,9 +236,32 @@ pub struct PrecomputeArgs {
     /// Solver threads (default: one per core); the modes do not depend on the count.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Surface meshes: estimate each mode's error from a second, coarser mesh and refine
+    /// until the lowest --accuracy-modes modes are estimated within PCT percent (or the
+    /// memory guard stops it, saying what was reached); `off`: one solve, no estimate.
+    /// An explicit --cell is kept (estimate only). Tet mesh files get no estimate.
+    #[arg(long, value_name = "PCT|off", default_value = "1", value_parser = parse_accuracy, allow_negative_numbers = true)]
+    pub accuracy: Accuracy,
+    /// The --accuracy target applies to the lowest N modes (all modes get an estimate).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub accuracy_modes: usize,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--accuracy`: a target in percent, or off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Accuracy(pub Option<f64>);
+
+fn parse_accuracy(s: &str) -> Result<Accuracy, String> {
+    if s.eq_ignore_ascii_case("off") {
+        return Ok(Accuracy(None));
+    }
+    match s.trim_end_matches('%').parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(Accuracy(Some(v))),
+        _ => Err(format!("expected a positive percentage (e.g. 1 or 0.5) or `off`, got {s:?}")),
+    }
 }
 
 #[derive(Debug, Args)]

@@ -22,6 +22,10 @@ pub struct ModeJson {
     pub radiated_power_w: Option<f64>,
     /// Radiation efficiency P / (½ρ₀c∫|v_n|²dS) (null: not stored).
     pub radiation_efficiency: Option<f64>,
+    /// Estimated discretization error of `frequency_hz` [% of it] (null: no
+    /// estimate — a prescribed tet mesh, an older bank, or a mode not matched
+    /// between the discretization levels). A contract: see docs/bank-format.md.
+    pub error_estimate_pct: Option<f64>,
 }
 
 /// Sylvester inertia count: eigenvalues below the check shift.
@@ -54,6 +58,8 @@ pub struct BankJson {
     pub surface_triangles: usize,
     pub material: modal_fem::Material,
     pub input_hash: String,
+    /// How the per-mode `error_estimate_pct` was obtained (null: no estimate).
+    pub error_estimate_method: Option<String>,
 }
 
 impl BankJson {
@@ -74,6 +80,8 @@ impl BankJson {
             surface_triangles: bank.surface.triangles.len(),
             material: bank.material.clone(),
             input_hash: info.input_hash.clone(),
+            error_estimate_method: (!info.error_estimate_method.is_empty())
+                .then(|| info.error_estimate_method.clone()),
         }
     }
 
@@ -116,11 +124,15 @@ impl BankJson {
             m.beta
         )?;
         let radiation = self.modes.iter().any(|m| m.radiated_power_w.is_some());
+        let estimated = self.modes.iter().any(|m| m.error_estimate_pct.is_some());
         write!(
             out,
             "{:>5}  {:>14}  {:>13}  {:>11}  {:>10}",
             "mode", "frequency Hz", "damping ratio", "T60 s", "residual"
         )?;
+        if estimated {
+            write!(out, "  {:>8}", "error %")?;
+        }
         if radiation {
             write!(out, "  {:>12}  {:>10}", "radiated W", "rad. eff.")?;
         }
@@ -136,12 +148,22 @@ impl BankJson {
                 t60,
                 mode.residual
             )?;
+            if estimated {
+                let e = mode.error_estimate_pct.map_or("-".to_string(), |e| format!("{e:.3}"));
+                write!(out, "  {e:>8}")?;
+            }
             if radiation {
                 let p = mode.radiated_power_w.map_or("-".to_string(), |p| format!("{p:.3e}"));
                 let e = mode.radiation_efficiency.map_or("-".to_string(), |e| format!("{e:.3e}"));
                 write!(out, "  {p:>12}  {e:>10}")?;
             }
             writeln!(out)?;
+        }
+        match &self.error_estimate_method {
+            Some(method) => {
+                writeln!(out, "error %: estimated discretization error of the frequency ({method})")?
+            }
+            None => writeln!(out, "error %: no estimate in this bank (prescribed tet mesh or older bank)")?,
         }
         let t = &self.timings_s;
         writeln!(
@@ -169,5 +191,6 @@ fn mode_json(bank: &ModeBank, i: usize) -> ModeJson {
         t60_s: (decay_rate > 0.0).then(|| 1000f64.ln() / decay_rate),
         radiated_power_w: None,
         radiation_efficiency: None,
+        error_estimate_pct: bank.info.error_estimate_pct.get(i).copied().flatten(),
     }
 }

@@ -30,6 +30,13 @@ fn describe(stage: &Stage) -> String {
         Stage::Assemble { dofs } => format!("assembling K and M ({dofs} DOF)"),
         Stage::Solve(what) => format!("eigen solve: {what}"),
         Stage::Store => "storing the bank in the cache".into(),
+        Stage::Level { index: 0, .. } => "level 0 (requested element size)".into(),
+        Stage::Level { index: 1, size_factor } => {
+            format!("level 1 (element sizes x {size_factor:.2}) for the error estimate")
+        }
+        Stage::Level { index, size_factor } => {
+            format!("level {index} (element sizes x {size_factor:.2}) to reach the --accuracy target")
+        }
     }
 }
 
@@ -52,6 +59,10 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     request.max_freq_hz = args.max_freq;
     request.fix_box = args.fix_box;
     request.threads = args.threads;
+    request.accuracy = args
+        .accuracy
+        .0
+        .map(|target_pct| modal_precompute::AccuracyTarget { target_pct, modes: args.accuracy_modes });
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
     let spinner = Spinner::new("starting");
     let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| {

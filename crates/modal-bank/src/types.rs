@@ -32,6 +32,20 @@ pub struct SolveInfo {
     /// the bank is stored under (see `BankCache`). Retuned banks carry
     /// `retuned:<hex>` instead, so they never match a fresh solve's key.
     pub input_hash: String,
+    /// Estimated discretization error of each mode's frequency, in percent of
+    /// the frequency: `|f − f_converged| / f_converged · 100` as estimated by
+    /// `modal-precompute` (module `accuracy`), one entry per mode; `None`
+    /// where a mode could not be matched between the discretization levels.
+    /// Empty when no estimate was made (banks from before the field, banks
+    /// of prescribed tet meshes). Stored additively in the `solve_info` JSON
+    /// (omitted when empty, so older banks keep their bytes); a relative
+    /// error is invariant under the exact scalings of [`crate::retune`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub error_estimate_pct: Vec<Option<f64>>,
+    /// How `error_estimate_pct` was obtained, one line (e.g. the levels and
+    /// the convergence order used); empty when no estimate was made.
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub error_estimate_method: String,
 }
 
 /// Elastic modes of one object, restricted to its surface.

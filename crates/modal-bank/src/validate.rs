@@ -7,6 +7,8 @@
 //!   `d = ξ ω` for every mode (relative 1e-9; true for any viscous modal
 //!   damping, Rayleigh or measured — the damping need not come from the
 //!   material's α, β, although [`crate::retune`] recomputes it from them);
+//! - `info.error_estimate_pct` empty or one finite, non-negative (or absent)
+//!   value per mode;
 //! - shapes and positions finite; surface indices name surface nodes;
 //! - material physically possible; mass properties finite, mass and volume ≥ 0.
 
@@ -27,6 +29,7 @@ impl ModeBank {
         check_frequencies(&self.frequencies_hz)?;
         check_damping(self)?;
         check_nonnegative("residuals", &self.residuals)?;
+        check_error_estimates(self)?;
         check_shapes(self)?;
         check_surface(&self.surface)?;
         check_mass(&self.mass)
@@ -67,6 +70,29 @@ fn check_counts(bank: &ModeBank) -> Result<(), BankError> {
                 bank.surface.triangles.len(),
                 edges.len()
             )));
+        }
+    }
+    Ok(())
+}
+
+/// `info.error_estimate_pct`: empty (no estimate) or one entry per mode,
+/// each finite and ≥ 0 when present.
+fn check_error_estimates(bank: &ModeBank) -> Result<(), BankError> {
+    let estimates = &bank.info.error_estimate_pct;
+    let n = bank.frequencies_hz.len();
+    if !estimates.is_empty() && estimates.len() != n {
+        return Err(BankError::Inconsistent(format!(
+            "solve_info.error_estimate_pct has {} entries but frequencies_hz has {n}",
+            estimates.len()
+        )));
+    }
+    for (i, e) in estimates.iter().enumerate() {
+        if let Some(e) = *e {
+            if !(e.is_finite() && e >= 0.0) {
+                return Err(BankError::Inconsistent(format!(
+                    "solve_info.error_estimate_pct[{i}] = {e} is not a finite number >= 0"
+                )));
+            }
         }
     }
     Ok(())

@@ -8,7 +8,8 @@ use crate::{MeshSource, PrecomputeError, Request, SOLVER_VERSION};
 
 /// Hex digest identifying the result of `request`: mesh bytes (both files of
 /// a TetGen pair), scale, material incl. α and β, order, band, mode cap,
-/// clamping box, surface-meshing options and the solver version.
+/// clamping box, surface-meshing options, the accuracy target (surface meshes) and the
+/// solver version.
 pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
     let mut key = CacheKey::new(SOLVER_VERSION);
     match &request.source {
@@ -37,6 +38,12 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
         .add_str("fix_box", &format!("{:?}", request.fix_box))
         .add_str("mesher", &request.surface.tet_options().cache_key_fields())
         .add_str("part", &format!("{:?}", request.surface.part));
+    // The accuracy target chooses the discretization of a surface mesh (and adds the
+    // estimate); a prescribed tet mesh is solved as it is. Absent: the key is unchanged.
+    if let (Some(a), true) = (&request.accuracy, crate::levels::remeshable(&request.source)) {
+        key = key
+            .add_str("accuracy", &format!("{}:{}:{}", crate::levels::LEVELS_VERSION, a.target_pct, a.modes));
+    }
     Ok(key.finish())
 }
 

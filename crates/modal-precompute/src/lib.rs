@@ -12,11 +12,17 @@
 //! 4. solve — shift-invert block Lanczos with rigid modes deflated, inertia check;
 //! 5. bank — mode shapes restricted to the surface, damping from Rayleigh α, β.
 
+pub mod accuracy;
 mod key;
+mod levels;
 mod load;
 mod pipeline;
 
 pub use key::cache_key;
+pub use levels::{
+    remeshable, AccuracyTarget, BAND_MARGIN, COARSE_FACTOR, LEVELS_VERSION, MAX_REFINEMENTS, MAX_STEP,
+    MIN_STEP, PRESCRIBED_NOTE,
+};
 pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, SurfaceMeshing};
 pub use pipeline::{
     assemble_matrices, precompute, residual_floor_warning, Assembled, Outcome, Request, Stage,

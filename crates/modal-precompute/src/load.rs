@@ -62,6 +62,19 @@ pub fn load_mesh(
     scale: f64,
     surface: &SurfaceMeshing,
 ) -> Result<LoadedMesh, PrecomputeError> {
+    load_mesh_sized(source, scale, surface, 1.0)
+}
+
+/// [`load_mesh`] with every element size of a surface mesh's tetrahedralization
+/// multiplied by `size_factor` (the discretization levels of `crate::levels`):
+/// an explicit cell becomes `cell × size_factor`; the default rule's cells per
+/// diagonal and per thickness are divided by it. Tet meshes are not touched.
+pub(crate) fn load_mesh_sized(
+    source: &MeshSource,
+    scale: f64,
+    surface: &SurfaceMeshing,
+    size_factor: f64,
+) -> Result<LoadedMesh, PrecomputeError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
     }
@@ -70,7 +83,13 @@ pub fn load_mesh(
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
             warnings.extend(report.warnings.iter().cloned());
-            let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &surface.tet_options())?;
+            let mut options = surface.tet_options();
+            if size_factor != 1.0 {
+                options.cell = options.cell.map(|c| c * size_factor);
+                options.cells_per_diagonal /= size_factor;
+                options.cells_per_thickness /= size_factor;
+            }
+            let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &options)?;
             warnings.extend(tet_report.warnings);
             mesh
         }

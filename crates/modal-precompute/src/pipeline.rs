@@ -9,8 +9,9 @@ use modal_eigen::{EigenOptions, EigenSolution};
 use modal_fem::Material;
 use modal_mesh::TetMesh;
 
-use crate::load::SurfaceMeshing;
-use crate::{cache_key, load_mesh, MeshSource, PrecomputeError};
+use crate::levels::AccuracyTarget;
+use crate::load::{load_mesh_sized, SurfaceMeshing};
+use crate::{cache_key, MeshSource, PrecomputeError};
 
 /// What to compute. `Default` gives the CLI's defaults for everything but
 /// the source and material.
@@ -37,10 +38,14 @@ pub struct Request {
     /// Threads of the sparse factorization and solves (`None`: one, measured
     /// fastest on 2 cores; the completeness check still overlaps on a second).
     pub threads: Option<usize>,
+    /// Per-mode error estimate and the accuracy to reach (surface meshes only, see
+    /// `crate::levels`); `None`: one solve at the given discretization, no estimate.
+    pub accuracy: Option<AccuracyTarget>,
 }
 
 impl Request {
-    /// A request with the CLI defaults: order 2, 20 Hz – 20 kHz, 64 modes.
+    /// A request with the CLI defaults: order 2, 20 Hz – 20 kHz, 64 modes; no
+    /// accuracy target (the CLI's `precompute` sets `--accuracy 1`).
     pub fn new(source: MeshSource, material: Material) -> Self {
         Request {
             source,
@@ -53,6 +58,7 @@ impl Request {
             max_modes: 64,
             fix_box: None,
             threads: None,
+            accuracy: None,
         }
     }
 
@@ -72,6 +78,17 @@ impl Request {
         }
         if self.max_modes == 0 {
             return invalid("--modes must be at least 1".into());
+        }
+        if let Some(a) = &self.accuracy {
+            if !(a.target_pct.is_finite() && a.target_pct > 0.0) {
+                return invalid(format!(
+                    "the accuracy target must be a positive percentage, got {}",
+                    a.target_pct
+                ));
+            }
+            if a.modes == 0 {
+                return invalid("the accuracy target must apply to at least one mode".into());
+            }
         }
         if self.fix_box.is_some_and(|b| b.iter().any(|x| !x.is_finite())) {
             return invalid("--fix-box must hold finite numbers".into());
@@ -94,6 +111,14 @@ pub enum Stage {
     Solve(String),
     /// Writing the bank to the cache.
     Store,
+    /// Starting discretization level `index` (0: the first) for the error estimate,
+    /// its element sizes × `size_factor` relative to the default.
+    Level {
+        /// 0, 1, ...
+        index: usize,
+        /// Element sizes relative to the first request.
+        size_factor: f64,
+    },
 }
 
 /// The result of [`precompute`].
@@ -130,22 +155,24 @@ pub fn assemble_matrices(
     request: &Request,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Assembled, PrecomputeError> {
-    Ok(assemble_and_analyze(request, false, progress)?.0)
+    Ok(assemble_and_analyze(request, false, 1.0, progress)?.0)
 }
 
 /// [`assemble_matrices`], and with `analyze` (and no clamps, which change the matrices
 /// solved) the eigensolver's ordering and symbolic factorization beside the numeric
 /// assembly: they depend on the pattern only, and the second core is partly idle while the
 /// element matrices are scattered (30k DOF: ≈ 0.14 s of ordering and analysis hidden).
-/// `assemble_s` is the wall time of both.
-fn assemble_and_analyze(
+/// `assemble_s` is the wall time of both. `size_factor` scales the element sizes of a
+/// surface mesh's tetrahedralization (see [`load_mesh_sized`]).
+pub(crate) fn assemble_and_analyze(
     request: &Request,
     analyze: bool,
+    size_factor: f64,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<(Assembled, Option<modal_eigen::Analysis>), PrecomputeError> {
     request.validate()?;
     progress(Stage::Load);
-    let loaded = load_mesh(&request.source, request.scale, &request.surface)?;
+    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, size_factor)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
@@ -212,9 +239,21 @@ pub fn precompute(
             Err(err) => warnings.push(format!("ignoring a damaged cache entry ({err}); recomputing")),
         }
     }
-    let (assembled, analysis) = assemble_and_analyze(request, true, progress)?;
-    warnings.extend(assembled.warnings.iter().cloned());
-    let bank = solve_bank(request, &assembled, analysis, key.clone(), progress)?;
+    let bank = match (&request.accuracy, crate::levels::remeshable(&request.source)) {
+        (Some(target), true) => {
+            let (bank, level_warnings) = crate::levels::solve_to_accuracy(request, target, &key, progress)?;
+            warnings.extend(level_warnings);
+            bank
+        }
+        (accuracy, remeshable) => {
+            let (assembled, analysis) = assemble_and_analyze(request, true, 1.0, progress)?;
+            warnings.extend(assembled.warnings.iter().cloned());
+            if accuracy.is_some() && !remeshable {
+                warnings.push(crate::levels::PRESCRIBED_NOTE.into());
+            }
+            solve_bank(request, &assembled, analysis, key.clone(), progress)?.0
+        }
+    };
     warnings.extend(residual_floor_warning(&bank));
     if let Some(cache) = cache {
         progress(Stage::Store);
@@ -249,14 +288,15 @@ pub fn residual_floor_warning(bank: &ModeBank) -> Option<String> {
     ))
 }
 
-/// Clamps, deflates rigid modes, solves and builds the bank.
-fn solve_bank(
+/// Clamps, deflates rigid modes, solves and builds the bank; also returns the
+/// solver's memory estimate [bytes].
+pub(crate) fn solve_bank(
     request: &Request,
     assembled: &Assembled,
     analysis: Option<modal_eigen::Analysis>,
     input_hash: String,
     progress: &mut dyn FnMut(Stage),
-) -> Result<ModeBank, PrecomputeError> {
+) -> Result<(ModeBank, u64), PrecomputeError> {
     let nodes = &assembled.mesh.nodes;
     let clamped = match request.fix_box {
         Some(b) => modal_fem::fix_box(nodes, b),
@@ -297,7 +337,8 @@ fn solve_bank(
     let solution = modal_eigen::solve_analyzed(k, m, rigid_ref, &options, analysis, &mut |p| {
         progress(Stage::Solve(format!("{p:?}")))
     })?;
-    Ok(build_bank(request, assembled, &dof_map, &solution, input_hash))
+    let memory = solution.stats.memory_estimate_bytes;
+    Ok((build_bank(request, assembled, &dof_map, &solution, input_hash), memory))
 }
 
 fn restrict_rows(fields: &Mat<f64>, rows: &[usize]) -> Mat<f64> {
@@ -349,6 +390,8 @@ fn build_bank(
             factor_s: stats.symbolic_s + stats.factor_s,
             solve_s: stats.solve_s + stats.check_s,
             input_hash,
+            error_estimate_pct: Vec::new(),
+            error_estimate_method: String::new(),
         },
     }
 }

@@ -72,6 +72,7 @@ fn bank_on(surface: Surface, n_modes: usize, mass: MassProperties) -> ModeBank {
             factor_s: 0.012345678901234567,
             solve_s: 1e-300,
             input_hash: "ab".repeat(32),
+            ..Default::default()
         },
     };
     bank.recompute_damping();

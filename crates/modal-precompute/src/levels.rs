@@ -1,0 +1,234 @@
+//! Discretization levels: the per-mode error estimate of every bank made from a
+//! surface mesh, and `--accuracy PCT` (issue 14, item 4).
+//!
+//! 1. Level 0 is the requested discretization (the mesher's default sizing, or the
+//!    user's `--cell`). A coarser level (all element sizes × [`COARSE_FACTOR`]) is
+//!    solved beside it and [`crate::accuracy::estimate`] gives each mode's error.
+//! 2. While the largest estimate over the lowest [`AccuracyTarget::modes`] modes is
+//!    above the target (or unknown), the element sizes shrink by the factor the
+//!    estimate predicts, `s' = s · 0.9 (target / worst)^{1/p}` (clamped to
+//!    [[`MIN_STEP`], [`MAX_STEP`]]), and the previous level becomes the coarse one. A
+//!    level whose predicted solver memory, `memory · (s / s')⁴` (DOF ∝ s⁻³, fill of a
+//!    nested-dissection factor ∝ DOF^{4/3}), exceeds the memory guard (75 % of the
+//!    available memory, the eigensolver's own default limit) is not attempted: the
+//!    bank says what it reached and what the next level would need. So does a level
+//!    refused by the mesher's or the solver's own guards.
+//! 3. An explicit `--cell` is a prescribed discretization: it gets its estimate and a
+//!    warning when the target is missed, with the cell that would reach it, but it is
+//!    not refined. A tet mesh file (or an in-memory mesh) cannot be re-meshed here: it
+//!    is solved as it is and gets no estimate ([`PRESCRIBED_NOTE`]).
+//!
+//! Every level is solved over a band widened by [`BAND_MARGIN`] (and a few more modes),
+//! so the modes near the band edges have partners on the other level; the bank is then
+//! cut back to the requested band and mode count.
+
+use modal_bank::ModeBank;
+
+use crate::accuracy::{estimate, LevelEstimate, ASSUMED_ORDER};
+use crate::pipeline::{assemble_and_analyze, solve_bank};
+use crate::{is_surface_file, MeshSource, PrecomputeError, Request, Stage};
+
+/// Part of the cache key of banks made to an accuracy target; bump when the levels
+/// or the estimate change.
+pub const LEVELS_VERSION: &str = "levels-1";
+
+/// Element sizes of the coarse level relative to the fine one.
+pub const COARSE_FACTOR: f64 = 1.5;
+
+/// Smallest and largest size step of one refinement.
+pub const MIN_STEP: f64 = 0.4;
+/// See [`MIN_STEP`].
+pub const MAX_STEP: f64 = 0.8;
+
+/// At most this many refinements after level 0.
+pub const MAX_REFINEMENTS: usize = 3;
+
+/// Levels are solved over `[min / BAND_MARGIN, max · BAND_MARGIN]`.
+pub const BAND_MARGIN: f64 = 1.3;
+
+/// Warning for a prescribed tet mesh under an accuracy target.
+pub const PRESCRIBED_NOTE: &str =
+    "no error estimate: a tet mesh file is solved as given (the estimate needs a \
+     second, coarser mesh of the same object; give the surface mesh (OBJ/STL/PLY) to get one)";
+
+/// What `--accuracy` asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AccuracyTarget {
+    /// Largest acceptable estimated error of a frequency [%].
+    pub target_pct: f64,
+    /// The target applies to the lowest this many modes of the bank (every mode
+    /// still gets its estimate).
+    pub modes: usize,
+}
+
+impl Default for AccuracyTarget {
+    /// 1 % on the lowest 10 modes (the CLI default).
+    fn default() -> Self {
+        AccuracyTarget { target_pct: 1.0, modes: 10 }
+    }
+}
+
+/// True when the source can be meshed at other sizes (a surface mesh file).
+pub fn remeshable(source: &MeshSource) -> bool {
+    matches!(source, MeshSource::File(path) if is_surface_file(path))
+}
+
+/// One solved level.
+struct Level {
+    bank: ModeBank,
+    dofs: usize,
+    memory: u64,
+    size_factor: f64,
+    warnings: Vec<String>,
+}
+
+fn solve_level(
+    wide: &Request,
+    index: usize,
+    size_factor: f64,
+    key: &str,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Level, PrecomputeError> {
+    progress(Stage::Level { index, size_factor });
+    let (assembled, analysis) = assemble_and_analyze(wide, true, size_factor, progress)?;
+    let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
+    Ok(Level { dofs: bank.info.dofs, bank, memory, size_factor, warnings: assembled.warnings })
+}
+
+/// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes.
+fn widened(request: &Request) -> Request {
+    let mut wide = request.clone();
+    wide.min_freq_hz = request.min_freq_hz / BAND_MARGIN;
+    wide.max_freq_hz = request.max_freq_hz * BAND_MARGIN;
+    wide.max_modes = request.max_modes + (request.max_modes / 4).max(6);
+    wide
+}
+
+/// Solves `request` (a surface mesh) on as many levels as `target` needs (see the
+/// module docs) and returns the finest bank with its per-mode estimate, plus warnings.
+pub(crate) fn solve_to_accuracy(
+    request: &Request,
+    target: &AccuracyTarget,
+    key: &str,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<(ModeBank, Vec<String>), PrecomputeError> {
+    let wide = widened(request);
+    let mut warnings = Vec::new();
+    let mut fine = solve_level(&wide, 0, 1.0, key, progress)?;
+    warnings.append(&mut fine.warnings);
+    let mut coarse = match solve_level(&wide, 1, COARSE_FACTOR, key, progress) {
+        Ok(level) => level,
+        Err(err) => {
+            warnings.push(format!(
+                "no error estimate: the coarser level (element sizes × {COARSE_FACTOR}) failed: {err}"
+            ));
+            return Ok((trim(&fine.bank, request, None).0, warnings));
+        }
+    };
+    let prescribed = request.surface.cell.is_some();
+    for refinement in 0.. {
+        let est = estimate(&fine.bank, &coarse.bank, fine.dofs, coarse.dofs);
+        let (mut bank, kept) = trim(&fine.bank, request, Some(&est));
+        bank.info.error_estimate_method = est.method(fine.dofs, coarse.dofs);
+        let worst = kept.worst_of_first(target.modes);
+        if worst.is_some_and(|w| w <= target.target_pct) {
+            return Ok((bank, warnings));
+        }
+        let reached = describe_worst(worst, target);
+        // The size that would reach the target by the estimate's own model.
+        let wanted = worst.map_or(MAX_STEP, |w| 0.9 * (target.target_pct / w).powf(1.0 / ASSUMED_ORDER));
+        let step = wanted.clamp(MIN_STEP, MAX_STEP);
+        if prescribed {
+            let cell = request.surface.cell.unwrap_or_default();
+            warnings.push(format!(
+                "{reached} at the given --cell {cell:.4e} m; about --cell {:.4e} m would reach {} %",
+                cell * wanted.min(MAX_STEP),
+                target.target_pct
+            ));
+            return Ok((bank, warnings));
+        }
+        let predicted = fine.memory as f64 * (1.0 / step).powi(4);
+        let guard = memory_guard_bytes();
+        if refinement == MAX_REFINEMENTS || guard.is_some_and(|g| predicted > g as f64) {
+            let why = match guard {
+                Some(g) if predicted > g as f64 => format!(
+                    "the next finer level (element sizes × {:.2}) would need ≈ {:.1} GB, above the memory guard of \
+                     {:.1} GB",
+                    fine.size_factor * step,
+                    predicted / 1e9,
+                    g as f64 / 1e9
+                ),
+                _ => format!("stopped after {MAX_REFINEMENTS} refinements"),
+            };
+            warnings.push(format!("{reached} ({} DOF): {why}", fine.dofs));
+            return Ok((bank, warnings));
+        }
+        match solve_level(&wide, refinement + 2, fine.size_factor * step, key, progress) {
+            Ok(mut finer) => {
+                warnings.append(&mut finer.warnings);
+                coarse = std::mem::replace(&mut fine, finer);
+            }
+            Err(err @ (PrecomputeError::Eigen(_) | PrecomputeError::Tetra(_))) => {
+                warnings.push(format!(
+                    "{reached} ({} DOF): the next finer level (element sizes × {:.2}) was refused: {err}",
+                    fine.dofs,
+                    fine.size_factor * step
+                ));
+                return Ok((bank, warnings));
+            }
+            Err(err) => return Err(err),
+        }
+    }
+    unreachable!("the loop returns")
+}
+
+fn describe_worst(worst: Option<f64>, target: &AccuracyTarget) -> String {
+    match worst {
+        Some(w) => format!(
+            "estimated error of the lowest {} modes up to {w:.2} % (target {} %)",
+            target.modes, target.target_pct
+        ),
+        None => format!(
+            "some of the lowest {} modes could not be matched between levels, so their error is unknown (target {} %)",
+            target.modes, target.target_pct
+        ),
+    }
+}
+
+/// The modes of `bank` inside the request's band, at most `max_modes`, with their
+/// estimates stored in the bank's `info`; and the estimate cut to the same modes.
+fn trim(bank: &ModeBank, request: &Request, est: Option<&LevelEstimate>) -> (ModeBank, LevelEstimate) {
+    let keep: Vec<usize> = (0..bank.mode_count())
+        .filter(|&i| (request.min_freq_hz..=request.max_freq_hz).contains(&bank.frequencies_hz[i]))
+        .take(request.max_modes)
+        .collect();
+    let s3 = 3 * bank.surface_node_count();
+    let pick = |v: &[f64]| keep.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+    let mut out = bank.clone();
+    out.frequencies_hz = pick(&bank.frequencies_hz);
+    out.damping_ratios = pick(&bank.damping_ratios);
+    out.decay_rates = pick(&bank.decay_rates);
+    out.residuals = pick(&bank.residuals);
+    out.shapes = keep.iter().flat_map(|&i| bank.shapes[i * s3..(i + 1) * s3].iter().copied()).collect();
+    let kept = match est {
+        Some(e) => LevelEstimate {
+            error_pct: keep.iter().map(|&i| e.error_pct[i]).collect(),
+            matched: keep.iter().map(|&i| e.matched[i]).collect(),
+            mac: keep.iter().map(|&i| e.mac[i]).collect(),
+            ratio: e.ratio,
+        },
+        None => LevelEstimate { error_pct: Vec::new(), matched: Vec::new(), mac: Vec::new(), ratio: 0.0 },
+    };
+    if est.is_some() {
+        out.info.error_estimate_pct = kept.error_pct.clone();
+    }
+    (out, kept)
+}
+
+/// 75 % of MemAvailable (the eigensolver's default memory limit), if known.
+fn memory_guard_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024 / 4 * 3)
+}
