@@ -27,6 +27,11 @@
 //!   (a 2 cm ball at 0.5 m/s left the floor every ≈ 0.1 s), which is heard as
 //!   ticks when it should roll smoothly (issue #16).
 //!
+//! Every convex polyhedron (a hull, each part of a decomposition) is a
+//! [`FaceHull`]: parry's own polyhedron reduces a face with many vertices to
+//! its first 4 when generating contacts, which let a flat thin disc sink
+//! through the floor ([`crate::face_hull`]).
+//!
 //! A decomposition costs set-up time (measured in `docs/benchmarks/scene.md`),
 //! so it is computed once per distinct bank and shared by its instances
 //! ([`ShapeCache`]).
@@ -37,6 +42,7 @@ use modal_bank::ModeBank;
 use parry3d::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::*;
 
+use crate::face_hull::FaceHull;
 use crate::spec::{ColliderKind, AUTO_DECOMPOSITION_RATIO};
 use crate::SceneError;
 
@@ -137,12 +143,17 @@ pub(crate) fn surface_triangles(bank: &ModeBank) -> Vec<[u32; 3]> {
     bank.surface.triangles.iter().map(|t| t.map(|k| k as u32)).collect()
 }
 
+/// The convex hull of `points` as a [`FaceHull`].
+fn face_hull(points: &[Vector]) -> Option<SharedShape> {
+    parry3d::shape::ConvexPolyhedron::from_convex_hull(points).map(|p| SharedShape::new(FaceHull::new(p)))
+}
+
 /// The convex hull of `points`, with at most [`MAX_HULL_VERTICES`] vertices.
 fn reduced_hull(points: &[Vector]) -> Option<SharedShape> {
     if points.len() <= MAX_HULL_VERTICES {
-        return SharedShape::convex_hull(points);
+        return face_hull(points);
     }
-    SharedShape::convex_hull(&extreme_points(points, MAX_HULL_VERTICES))
+    face_hull(&extreme_points(points, MAX_HULL_VERTICES))
 }
 
 /// The points of `points` extreme along `k` directions spread evenly over
@@ -255,7 +266,7 @@ fn decomposition(bank: &ModeBank, points: &[Vector], path: &str) -> Result<Share
     let parts: Vec<(Pose, SharedShape)> = VHACD::decompose(&params, points, &triangles, true)
         .compute_exact_convex_hulls(points, &triangles)
         .into_iter()
-        .filter_map(|(vertices, _)| SharedShape::convex_hull(&vertices))
+        .filter_map(|(vertices, _)| face_hull(&vertices))
         .map(|s| (Pose::IDENTITY, s))
         .collect();
     if parts.is_empty() {
@@ -288,7 +299,7 @@ mod tests {
     fn reduced_hull_keeps_few_vertices_and_stays_close_inside() {
         let points = sphere_points(3000);
         let hull = reduced_hull(&points).expect("hull");
-        let poly = hull.as_convex_polyhedron().expect("polyhedron");
+        let poly = hull.as_shape::<FaceHull>().expect("face hull").polyhedron();
         assert!(poly.points().len() <= MAX_HULL_VERTICES, "{} vertices", poly.points().len());
         // Every dropped point lies outside (or on) the reduced hull, by at most
         // the sag between the kept vertices (384 directions α ≈ 0.18 rad
@@ -298,7 +309,7 @@ mod tests {
         // Small hulls stay exact.
         let few = sphere_points(100);
         let exact = reduced_hull(&few).expect("hull");
-        assert_eq!(exact.as_convex_polyhedron().expect("polyhedron").points().len(), 100);
+        assert_eq!(exact.as_shape::<FaceHull>().expect("face hull").polyhedron().points().len(), 100);
     }
 
     /// The plain per-direction scan [`extreme_points`] must reproduce.

@@ -20,6 +20,7 @@
 mod collider;
 mod error;
 mod excite;
+mod face_hull;
 mod ground;
 mod listener;
 mod material;
