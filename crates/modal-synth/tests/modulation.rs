@@ -170,3 +170,46 @@ fn unit_factors_equal_the_unmodulated_voice() {
     let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs() as f64));
     assert!(err < 1e-6 * peak, "{err} vs {peak}");
 }
+
+/// Cost of the modulation against real gains: a 600-mode voice, 2 s at
+/// 48 kHz, five repetitions each, medians printed. Timing only, no
+/// assertion on it:
+/// `cargo test --release -p modal-synth --test modulation -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn cost_of_complex_time_varying_weights_against_real_gains() {
+    let bank = common::many_modes(600);
+    let n = bank.mode_count();
+    let gains = vec![1.0; n];
+    let src = Arc::new(Source {
+        kind: Kind::Exponential,
+        params: (0..n).map(|i| (C64::new(0.5, 0.5), -0.1, 3.0 + 0.01 * i as f64)).collect(),
+    });
+    let time = |m: Option<Arc<Source>>| {
+        let mut runs: Vec<f64> = (0..5)
+            .map(|_| {
+                let mut v =
+                    ModalVoice::new(&bank, opts(gains.clone(), OutputQuantity::Velocity, Kernel::Auto))
+                        .unwrap();
+                if let Some(m) = &m {
+                    v.set_modulation(m.clone());
+                }
+                v.add_impulse(0.0, [0.07, 0.02, 0.004], [0.3, -1.0, 0.2], 0.0).unwrap();
+                let mut out = vec![0.0f32; 96_000];
+                let t = std::time::Instant::now();
+                v.render(&mut out, 0);
+                t.elapsed().as_secs_f64()
+            })
+            .collect();
+        runs.sort_by(f64::total_cmp);
+        runs[2]
+    };
+    let plain = time(None);
+    let modulated = time(Some(src));
+    eprintln!(
+        "600 modes, 2 s at 48 kHz: real gains {:.1} ms, modulated {:.1} ms (x{:.2})",
+        plain * 1e3,
+        modulated * 1e3,
+        modulated / plain
+    );
+}
