@@ -160,8 +160,9 @@ impl BankTransfer {
             let mut sum = C64::ZERO;
             for (l, e) in eta.iter().enumerate() {
                 let mut part = C64::ZERO;
-                for j in l * l..(l + 1) * (l + 1) {
-                    part += m.scaled[j] * C64::new(y[j].re, y[j].im);
+                let range = l * l..(l + 1) * (l + 1);
+                for (a, yj) in m.scaled[range.clone()].iter().zip(&y[range]) {
+                    part += *a * C64::new(yj.re, yj.im);
                 }
                 sum += *e * part;
             }
