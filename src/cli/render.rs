@@ -39,6 +39,8 @@ struct PipelineProvider<'a> {
     deferred_failed: Arc<AtomicBool>,
     /// Acoustic transfers solved in this run: (asset, modes, seconds).
     radiation_solved: Vec<(String, usize, f64)>,
+    /// Solve missing acoustic transfers now (`--solve-radiation`).
+    solve_radiation: bool,
 }
 
 impl BankProvider for PipelineProvider<'_> {
@@ -179,6 +181,9 @@ impl PipelineProvider<'_> {
                     .warnings
                     .push(format!("{what}: damaged radiation cache entry {}: solving again", path.display())),
             }
+        }
+        if !self.solve_radiation {
+            return Err("none cached: render once with --solve-radiation to solve and cache it".into());
         }
         let mesh = modal_radiation::modes::boundary_mesh(bank)?;
         let started = std::time::Instant::now();
@@ -327,6 +332,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         defer: true,
         deferred_failed: Arc::new(AtomicBool::new(false)),
         radiation_solved: Vec::new(),
+        solve_radiation: args.solve_radiation,
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);
