@@ -10,12 +10,17 @@ use crate::{BankError, ModeBank};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Writes `path` atomically with `write`, which receives a buffered sink.
-pub(crate) fn atomic_write(
+/// Writes `path` atomically: `write` fills a temporary file in the same
+/// directory (which must exist: a typo in a path is an error, not a new
+/// directory), which is flushed to disk and then renamed
+/// over `path`. Readers and concurrent writers of the same path (shards on a
+/// shared file system) see the old file or a complete new one, never a partial
+/// one; on error nothing is left behind. The one place every crate writes
+/// outputs through (banks, catalogues, WAVs).
+pub fn write_file_atomically(
     path: &Path,
-    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), BankError> {
-    let err = |source| BankError::Write { path: path.to_path_buf(), source };
+    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -26,15 +31,24 @@ pub(crate) fn atomic_write(
     // Like a plain `File::create`: 0o666 minus the umask, not tempfile's 0o600.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let tmp = builder.tempfile_in(&dir).map_err(err)?;
-    {
-        let mut w = BufWriter::new(tmp.as_file());
-        write(&mut w).map_err(err)?;
-        w.flush().map_err(err)?;
-    }
-    tmp.as_file().sync_all().map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error))?;
+    let mut tmp = builder.tempfile_in(&dir)?;
+    write(tmp.as_file_mut())?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// [`write_file_atomically`] through a buffered sink, errors as [`BankError::Write`].
+pub(crate) fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), BankError> {
+    write_file_atomically(path, |file| {
+        let mut w = BufWriter::new(file);
+        write(&mut w)?;
+        w.flush()
+    })
+    .map_err(|source| BankError::Write { path: path.to_path_buf(), source })
 }
 
 fn is_file(f: &std::fs::File) -> bool {

@@ -42,5 +42,6 @@ pub use damping::rayleigh;
 pub use deferred::DeferredBank;
 pub use error::BankError;
 pub use format::{FORMAT_NAME, FORMAT_VERSION, OLDEST_READABLE_VERSION};
+pub use fsio::write_file_atomically;
 pub use radiation::{ModeTransfer, RadiationTable};
 pub use types::*;

@@ -2,8 +2,9 @@
 //! surface mesh, and `--accuracy PCT` (issue 14, item 4).
 //!
 //! 1. Level 0 is the requested discretization (the mesher's default sizing, or the
-//!    user's `--cell`). A coarser level (all element sizes × [`COARSE_FACTOR`]) is
-//!    solved beside it and [`crate::accuracy::estimate`] gives each mode's error.
+//!    user's `--cell`). A coarser level (the tetrahedralizer's cell × [`COARSE_FACTOR`];
+//!    its whole sizing field scales with the cell) is solved beside it and
+//!    [`crate::accuracy::estimate`] gives each mode's error.
 //! 2. While the largest estimate over the lowest [`AccuracyTarget::modes`] modes is
 //!    above the target (or unknown), the element sizes shrink by the factor the
 //!    estimate predicts, `s' = s · 0.9 (target / worst)^{1/p}` (clamped to
@@ -30,7 +31,7 @@ use crate::{is_surface_file, MeshSource, PrecomputeError, Request, Stage};
 
 /// Part of the cache key of banks made to an accuracy target; bump when the levels
 /// or the estimate change.
-pub const LEVELS_VERSION: &str = "levels-1";
+pub const LEVELS_VERSION: &str = "levels-3";
 
 /// Element sizes of the coarse level relative to the fine one.
 pub const COARSE_FACTOR: f64 = 1.5;
@@ -79,20 +80,28 @@ struct Level {
     dofs: usize,
     memory: u64,
     size_factor: f64,
+    /// The tetrahedralizer's cell of this level [m].
+    cell_m: f64,
     warnings: Vec<String>,
 }
 
+/// Solves level `index`: the request's own discretization for `base_cell = None`,
+/// else the tetrahedralizer's cell `base_cell × size_factor` (its whole sizing field
+/// scales with the cell).
 fn solve_level(
     wide: &Request,
     index: usize,
+    base_cell: Option<f64>,
     size_factor: f64,
     key: &str,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Level, PrecomputeError> {
     progress(Stage::Level { index, size_factor });
-    let (assembled, analysis) = assemble_and_analyze(wide, true, size_factor, progress)?;
+    let level_cell = base_cell.map(|c| c * size_factor);
+    let (assembled, analysis) = assemble_and_analyze(wide, true, level_cell, progress)?;
     let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
-    Ok(Level { dofs: bank.info.dofs, bank, memory, size_factor, warnings: assembled.warnings })
+    let cell_m = assembled.cell_m.or(level_cell).unwrap_or(f64::NAN);
+    Ok(Level { dofs: bank.info.dofs, bank, memory, size_factor, cell_m, warnings: assembled.warnings })
 }
 
 /// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes.
@@ -114,9 +123,10 @@ pub(crate) fn solve_to_accuracy(
 ) -> Result<(ModeBank, Vec<String>), PrecomputeError> {
     let wide = widened(request);
     let mut warnings = Vec::new();
-    let mut fine = solve_level(&wide, 0, 1.0, key, progress)?;
+    let mut fine = solve_level(&wide, 0, None, 1.0, key, progress)?;
     warnings.append(&mut fine.warnings);
-    let mut coarse = match solve_level(&wide, 1, COARSE_FACTOR, key, progress) {
+    let base_cell = Some(fine.cell_m).filter(|c| c.is_finite() && *c > 0.0);
+    let mut coarse = match solve_level(&wide, 1, base_cell, COARSE_FACTOR, key, progress) {
         Ok(level) => level,
         Err(err) => {
             warnings.push(format!(
@@ -152,9 +162,8 @@ pub(crate) fn solve_to_accuracy(
         if refinement == MAX_REFINEMENTS || guard.is_some_and(|g| predicted > g as f64) {
             let why = match guard {
                 Some(g) if predicted > g as f64 => format!(
-                    "the next finer level (element sizes × {:.2}) would need ≈ {:.1} GB, above the memory guard of \
-                     {:.1} GB",
-                    fine.size_factor * step,
+                    "the next finer level (cell {:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB",
+                    fine.cell_m * step,
                     predicted / 1e9,
                     g as f64 / 1e9
                 ),
@@ -163,16 +172,16 @@ pub(crate) fn solve_to_accuracy(
             warnings.push(format!("{reached} ({} DOF): {why}", fine.dofs));
             return Ok((bank, warnings));
         }
-        match solve_level(&wide, refinement + 2, fine.size_factor * step, key, progress) {
+        match solve_level(&wide, refinement + 2, base_cell, fine.size_factor * step, key, progress) {
             Ok(mut finer) => {
                 warnings.append(&mut finer.warnings);
                 coarse = std::mem::replace(&mut fine, finer);
             }
             Err(err @ (PrecomputeError::Eigen(_) | PrecomputeError::Tetra(_))) => {
                 warnings.push(format!(
-                    "{reached} ({} DOF): the next finer level (element sizes × {:.2}) was refused: {err}",
+                    "{reached} ({} DOF): the next finer level (cell {:.2e} m) was refused: {err}",
                     fine.dofs,
-                    fine.size_factor * step
+                    fine.cell_m * step
                 ));
                 return Ok((bank, warnings));
             }

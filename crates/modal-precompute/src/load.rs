@@ -48,6 +48,9 @@ pub struct LoadedMesh {
     pub part_of_node: Vec<usize>,
     /// Things the user should know (reoriented tets, dropped nodes, unit hints).
     pub warnings: Vec<String>,
+    /// The tetrahedralizer's cell size [m] (`TetReport::cell_m`) for a surface
+    /// mesh; `None` for a tet mesh.
+    pub cell_m: Option<f64>,
 }
 
 /// True for file types that hold a surface to be tetrahedralized.
@@ -62,35 +65,34 @@ pub fn load_mesh(
     scale: f64,
     surface: &SurfaceMeshing,
 ) -> Result<LoadedMesh, PrecomputeError> {
-    load_mesh_sized(source, scale, surface, 1.0)
+    load_mesh_sized(source, scale, surface, None)
 }
 
-/// [`load_mesh`] with every element size of a surface mesh's tetrahedralization
-/// multiplied by `size_factor` (the discretization levels of `crate::levels`):
-/// an explicit cell becomes `cell × size_factor`; the default rule's cells per
-/// diagonal and per thickness are divided by it. Tet meshes are not touched.
+/// [`load_mesh`] with the tetrahedralizer's cell of a surface mesh set to
+/// `level_cell` when given (the discretization levels of `crate::levels`: the
+/// mesher's whole sizing field scales with its cell). Tet meshes are not touched.
 pub(crate) fn load_mesh_sized(
     source: &MeshSource,
     scale: f64,
     surface: &SurfaceMeshing,
-    size_factor: f64,
+    level_cell: Option<f64>,
 ) -> Result<LoadedMesh, PrecomputeError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
     }
     let mut warnings = Vec::new();
+    let mut cell_m = None;
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
             warnings.extend(report.warnings.iter().cloned());
             let mut options = surface.tet_options();
-            if size_factor != 1.0 {
-                options.cell = options.cell.map(|c| c * size_factor);
-                options.cells_per_diagonal /= size_factor;
-                options.cells_per_thickness /= size_factor;
+            if level_cell.is_some() {
+                options.cell = level_cell;
             }
             let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &options)?;
             warnings.extend(tet_report.warnings);
+            cell_m = Some(tet_report.cell_m);
             mesh
         }
         MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,
@@ -103,5 +105,5 @@ pub(crate) fn load_mesh_sized(
     let (mesh, report) = modal_mesh::check(raw)?;
     warnings.extend(report.warnings.iter().cloned());
     let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
-    Ok(LoadedMesh { mesh, parts, part_of_node, warnings })
+    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m })
 }

@@ -148,6 +148,8 @@ pub struct Assembled {
     pub assemble_s: f64,
     /// Warnings collected while loading.
     pub warnings: Vec<String>,
+    /// The tetrahedralizer's cell size [m] for a surface mesh (`None`: tet mesh).
+    pub cell_m: Option<f64>,
 }
 
 /// Loads the mesh and assembles K and M (what `export-matrices` writes).
@@ -155,24 +157,24 @@ pub fn assemble_matrices(
     request: &Request,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Assembled, PrecomputeError> {
-    Ok(assemble_and_analyze(request, false, 1.0, progress)?.0)
+    Ok(assemble_and_analyze(request, false, None, progress)?.0)
 }
 
 /// [`assemble_matrices`], and with `analyze` (and no clamps, which change the matrices
 /// solved) the eigensolver's ordering and symbolic factorization beside the numeric
 /// assembly: they depend on the pattern only, and the second core is partly idle while the
 /// element matrices are scattered (30k DOF: ≈ 0.14 s of ordering and analysis hidden).
-/// `assemble_s` is the wall time of both. `size_factor` scales the element sizes of a
-/// surface mesh's tetrahedralization (see [`load_mesh_sized`]).
+/// `assemble_s` is the wall time of both. `level_cell` sets the tetrahedralizer's cell
+/// of a surface mesh (see [`load_mesh_sized`]).
 pub(crate) fn assemble_and_analyze(
     request: &Request,
     analyze: bool,
-    size_factor: f64,
+    level_cell: Option<f64>,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<(Assembled, Option<modal_eigen::Analysis>), PrecomputeError> {
     request.validate()?;
     progress(Stage::Load);
-    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, size_factor)?;
+    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level_cell)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
@@ -197,6 +199,7 @@ pub(crate) fn assemble_and_analyze(
         m: assembly.m,
         assemble_s: start.elapsed().as_secs_f64(),
         warnings: loaded.warnings,
+        cell_m: loaded.cell_m,
     };
     Ok((assembled, analysis))
 }
@@ -246,7 +249,7 @@ pub fn precompute(
             bank
         }
         (accuracy, remeshable) => {
-            let (assembled, analysis) = assemble_and_analyze(request, true, 1.0, progress)?;
+            let (assembled, analysis) = assemble_and_analyze(request, true, None, progress)?;
             warnings.extend(assembled.warnings.iter().cloned());
             if accuracy.is_some() && !remeshable {
                 warnings.push(crate::levels::PRESCRIBED_NOTE.into());

@@ -71,14 +71,19 @@ const LABEL: f32 = 18.0;
 const TICK: f32 = 16.0;
 /// Legend line spacing [px].
 const LINE: i32 = 26;
-/// Line colours of successive series.
-const PALETTE: [RGBColor; 6] = [
+/// Line colours of successive series (the ten "tab10" colours: up to ten curves
+/// stay distinguishable; the synthesis plot has eight).
+const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(255, 127, 14),
     RGBColor(23, 190, 207),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
 ];
 const GRID: RGBColor = RGBColor(225, 225, 225);
 

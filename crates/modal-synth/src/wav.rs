@@ -123,16 +123,6 @@ pub fn write_wav(
         path: path.display().to_string(),
         message: e.to_string(),
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".modal-wav-").suffix(".tmp");
-    // Like a plain `File::create` (0o666 minus the umask), not 0o600.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(dir).map_err(|e| fail(&e))?;
     let spec = hound::WavSpec {
         channels: channels.len() as u16,
         sample_rate,
@@ -144,13 +134,15 @@ pub fn write_wav(
         },
     };
     let mut clipped = 0;
-    {
-        let mut w = hound::WavWriter::new(BufWriter::new(tmp.as_file_mut()), spec).map_err(|e| fail(&e))?;
+    // hound errors travel through io::Error to the one atomic writer.
+    let hound_io = |e: hound::Error| std::io::Error::other(e.to_string());
+    modal_bank::write_file_atomically(path, |file| {
+        let mut w = hound::WavWriter::new(BufWriter::new(file), spec).map_err(hound_io)?;
         match format {
             WavFormat::Float32 => {
                 for f in 0..frames {
                     for c in channels {
-                        w.write_sample((c[f] as f64 * g) as f32).map_err(|e| fail(&e))?;
+                        w.write_sample((c[f] as f64 * g) as f32).map_err(hound_io)?;
                     }
                 }
             }
@@ -173,13 +165,13 @@ pub fn write_wav(
                             block.write_sample(c[f]);
                         }
                     }
-                    block.flush().map_err(|e| fail(&e))?;
+                    block.flush().map_err(hound_io)?;
                 }
             }
         }
-        w.finalize().map_err(|e| fail(&e))?;
-    }
-    tmp.persist(path).map_err(|e| fail(&e.error))?;
+        w.finalize().map_err(hound_io)
+    })
+    .map_err(|e| fail(&e))?;
     Ok(WavReport {
         channels: channels.len() as u16,
         frames,

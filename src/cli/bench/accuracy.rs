@@ -44,6 +44,10 @@ pub struct AccuracyBenchArgs {
     /// Max relative error the mesh-size recommendation aims for.
     #[arg(long, default_value_t = 0.01)]
     target_error: f64,
+    /// Redraw the PNG plots from a saved `--json` report instead of running the cases
+    /// (for example after a change to the plotting); prints the plot paths.
+    #[arg(long, value_name = "REPORT.json", conflicts_with_all = ["case", "shapes", "orders", "levels"])]
+    replot: Option<PathBuf>,
     /// Run one case (shape:order:level or shape:order:h=<mm>) in this process and print it
     /// as one JSON line.
     #[arg(long, hide = true)]
@@ -54,6 +58,9 @@ pub struct AccuracyBenchArgs {
 pub fn run(args: AccuracyBenchArgs) -> Result<()> {
     if let Some(case) = &args.case {
         return run_child(case);
+    }
+    if let Some(saved) = &args.replot {
+        return replot(saved, &args.plot_dir);
     }
     let specs = plan(&args)?;
     let cases = run_cases(&specs, args.max_case_seconds)?;
@@ -67,6 +74,25 @@ pub fn run(args: AccuracyBenchArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display())),
         None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
     }
+}
+
+/// `--replot`: the plots of a saved report, drawn again without solving anything.
+fn replot(saved: &std::path::Path, plot_dir: &std::path::Path) -> Result<()> {
+    let text = std::fs::read_to_string(saved).with_context(|| format!("cannot read {}", saved.display()))?;
+    let mut report: StudyReport = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a `modal bench accuracy --json` report", saved.display()))?;
+    if report.cases.is_empty() {
+        bail!("{} has no cases to plot", saved.display());
+    }
+    report.plots.clear();
+    std::fs::create_dir_all(plot_dir)
+        .with_context(|| format!("cannot create plot directory {}", plot_dir.display()))?;
+    report.write_plots(plot_dir)?;
+    let mut out = std::io::stdout().lock();
+    for path in &report.plots {
+        writeln!(out, "{}", path.display())?;
+    }
+    Ok(())
 }
 
 /// The hidden `--case` mode: one case, one JSON line with this process's peak memory.
