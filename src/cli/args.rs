@@ -393,6 +393,11 @@ pub struct RenderArgs {
     /// Solver threads (default: one per core); the modes do not depend on the count.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Solve each mesh asset's acoustic transfer now when the cache has none
+    /// (boundary elements: minutes per asset; cached afterwards). Without it,
+    /// assets without a stored or cached transfer use the level estimate.
+    #[arg(long)]
+    pub solve_radiation: bool,
 }
 
 /// Output format of a WAV file.

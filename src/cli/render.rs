@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
-use modal_bank::{BankCache, ModeBank};
+use modal_bank::{BankCache, CacheKey, ModeBank, RadiationTable};
 use modal_fem::Material;
 use modal_mesh::{Cells, TetMesh};
 use modal_precompute::{MeshSource, Request};
@@ -37,6 +37,10 @@ struct PipelineProvider<'a> {
     defer: bool,
     /// Set when a deferred entry failed its verification.
     deferred_failed: Arc<AtomicBool>,
+    /// Acoustic transfers solved in this run: (asset, modes, seconds).
+    radiation_solved: Vec<(String, usize, f64)>,
+    /// Solve missing acoustic transfers now (`--solve-radiation`).
+    solve_radiation: bool,
 }
 
 impl BankProvider for PipelineProvider<'_> {
@@ -87,6 +91,41 @@ impl BankProvider for PipelineProvider<'_> {
         }
         self.bank(request).map(ProvidedBank::Ready)
     }
+
+    /// A bank file's stored table; for a mesh, the cached table or a
+    /// solve now (then cached). Failures become a warning and the estimate.
+    fn radiation(
+        &mut self,
+        request: &BankRequest,
+        bank: &Arc<ModeBank>,
+    ) -> Result<Option<Arc<RadiationTable>>, ProviderError> {
+        let what = match (&request.mesh, &request.bank) {
+            (Some(mesh), _) => describe(mesh),
+            (None, Some(path)) => path.display().to_string(),
+            (None, None) => return Ok(None),
+        };
+        if let Some(path) = &request.bank {
+            let table = if modal_export::gltf::is_gltf_path(path) {
+                None
+            } else {
+                ModeBank::load_with_radiation(path)?.1
+            };
+            if table.is_none() {
+                self.warnings.push(format!(
+                    "{what} has no radiation table: its level is a pulsating-sphere estimate \
+                     (run `modal radiation BANK --store OUT.bank`)"
+                ));
+            }
+            return Ok(table.map(Arc::new));
+        }
+        match self.solved_radiation(request, bank, &what) {
+            Ok(table) => Ok(Some(table)),
+            Err(e) => {
+                self.warnings.push(format!("{what}: no acoustic transfer ({e}); its level is estimated"));
+                Ok(None)
+            }
+        }
+    }
 }
 
 /// A generator recipe resolved: shape, element size, order and the identity
@@ -103,6 +142,85 @@ fn recipe(
 }
 
 impl PipelineProvider<'_> {
+    /// The transfer of a mesh asset's bank: from the cache entry keyed by
+    /// the bank's key and the radiation settings, or solved now and cached.
+    fn solved_radiation(
+        &mut self,
+        request: &BankRequest,
+        bank: &ModeBank,
+        what: &str,
+    ) -> Result<Arc<RadiationTable>, ProviderError> {
+        let opts = modal_radiation::RadiationOptions::default();
+        // Modes the synthesizer can play (below 0.45 fs, audible, not overdamped).
+        let top = modal_synth::MAX_FREQUENCY_FRACTION * 2.0 * request.max_frequency_hz;
+        let modes: Vec<usize> = (0..bank.mode_count())
+            .filter(|&i| {
+                let fd = bank.damped_frequency_hz(i);
+                fd >= modal_synth::MIN_FREQUENCY_HZ && fd < top && bank.damping_ratios[i] < 1.0
+            })
+            .collect();
+        let entry = match (&self.cache, self.bank_key(request)?) {
+            (Some(cache), Some(key)) => {
+                let key = CacheKey::new("modal-radiation-v1")
+                    .add_str("bank", &key)
+                    .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
+                    .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)
+                    .add_f64("multipole_tolerance", opts.multipole_tolerance)
+                    .add_f64("top_hz", top)
+                    .finish();
+                Some(cache.path_for(&key)?)
+            }
+            _ => None,
+        };
+        if let Some(path) = entry.as_ref().filter(|p| p.exists()) {
+            match ModeBank::load_with_radiation(path) {
+                Ok((cached, Some(table))) if cached.frequencies_hz == bank.frequencies_hz => {
+                    return Ok(Arc::new(table));
+                }
+                _ => self
+                    .warnings
+                    .push(format!("{what}: damaged radiation cache entry {}: solving again", path.display())),
+            }
+        }
+        if !self.solve_radiation {
+            return Err("none cached: render once with --solve-radiation to solve and cache it".into());
+        }
+        let mesh = modal_radiation::modes::boundary_mesh(bank)?;
+        let started = std::time::Instant::now();
+        let spinner = self.spinner;
+        let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &modes, &opts, &mut |p| {
+            spinner.set(format!(
+                "acoustic transfer of {what}: {}/{} at {:.0} Hz ({} panels)",
+                p.groups_done, p.groups, p.frequency_hz, p.panels
+            ))
+        })?;
+        let table = modal_radiation::modes::to_table(&results, &opts).ok_or("no audible mode")?;
+        self.radiation_solved.push((what.to_string(), results.len(), started.elapsed().as_secs_f64()));
+        if let Some(path) = &entry {
+            if let Err(e) = bank.save_with_radiation(path, &table) {
+                self.warnings.push(format!("{what}: cannot cache the acoustic transfer: {e}"));
+            }
+        }
+        Ok(Arc::new(table))
+    }
+
+    /// The cache key of a mesh asset's bank (`None` for bank files).
+    fn bank_key(&self, request: &BankRequest) -> Result<Option<String>, ProviderError> {
+        let Some(material) = &request.material else { return Ok(None) };
+        Ok(Some(match &request.mesh {
+            Some(modal_scene::MeshSource::Generate(spec)) => {
+                let (_, _, _, identity) = recipe(spec, request)?;
+                self.generated_key(request, material, &identity)?
+            }
+            Some(modal_scene::MeshSource::File(path)) => modal_precompute::cache_key(&self.request(
+                request,
+                material.clone(),
+                MeshSource::File(path.clone()),
+            ))?,
+            None => return Ok(None),
+        }))
+    }
+
     /// The precompute request for a scene object's bank.
     fn request(&self, request: &BankRequest, material: Material, source: MeshSource) -> Request {
         let mut pipeline = Request::new(source, material);
@@ -213,6 +331,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
         solved: 0,
         defer: true,
         deferred_failed: Arc::new(AtomicBool::new(false)),
+        radiation_solved: Vec::new(),
+        solve_radiation: args.solve_radiation,
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);
@@ -228,8 +348,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
     spinner.set("writing");
     let (warnings, cached, solved) =
         (std::mem::take(&mut provider.warnings), provider.cached, provider.solved);
+    let radiation_solved = std::mem::take(&mut provider.radiation_solved);
     spinner.finish();
     warnings.iter().for_each(|w| warn(w));
+    for (what, modes, seconds) in &radiation_solved {
+        eprintln!("acoustic transfer of {what}: {modes} mode(s) solved in {seconds:.1} s (cached)");
+    }
     let rendered = rendered.context("render failed")?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let wav = interrupt::guarded(|| modal_scene::write_wav(&rendered, &out, format))?;
@@ -259,28 +383,30 @@ pub fn run(args: RenderArgs) -> Result<()> {
 
 fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, solved: usize) {
     println!(
-        "{:>16}  {:>7}  {:>7}  {:>12}  {:>14}  {:>12}",
-        "object", "impacts", "modes", "mode-samples", "samples", "peak Pa @1m"
+        "{:>16}  {:>7}  {:>7}  {:>8}  {:>12}  {:>14}  {:>12}",
+        "object", "impacts", "modes", "transfer", "mode-samples", "samples", "peak Pa @1m"
     );
     for o in &report.objects {
         println!(
-            "{:>16}  {:>7}  {:>3}/{:<3}  {:>12}  {:>14}  {:>12.3e}",
+            "{:>16}  {:>7}  {:>3}/{:<3}  {:>8}  {:>12}  {:>14}  {:>12.3e}",
             o.name,
             o.impacts,
             o.modes_synthesized,
             o.modes_total,
+            o.modes_with_transfer,
             o.mode_samples,
             o.samples_computed,
             o.peak_pa_at_1m
         );
     }
     println!(
-        "banks: {} distinct ({} from cache, {} solved) in {:.2} s; colliders {:.3} s, physics {:.3} s ({} steps), \
-         excitation {:.3} s, synthesis {:.3} s, mix {:.3} s: {:.0}x real time",
+        "banks: {} distinct ({} from cache, {} solved) in {:.2} s; acoustic transfer {:.2} s; colliders {:.3} s, \
+         physics {:.3} s ({} steps), excitation {:.3} s, synthesis {:.3} s, mix {:.3} s: {:.0}x real time",
         report.banks_requested,
         cached,
         solved,
         report.banks_s,
+        report.radiation_s,
         report.colliders_s,
         report.physics_s,
         report.physics_steps,

@@ -6,7 +6,9 @@
 //! properties; after every physics step each contact's impulse (normal and
 //! friction) strikes both bodies' modes at the contact point, with a Hertz
 //! contact time and a sub-step onset time. Output: audio channels (mono or
-//! stereo) heard at a listener with 1/r attenuation and r/c delay, a
+//! stereo) heard at a listener with 1/r attenuation, r/c delay and each
+//! mode's acoustic transfer in the body's rotating frame (module
+//! `transfer`; optionally a ground reflection), a
 //! [`RenderReport`], optional impact events (JSON) and a spectrogram (PNG).
 //!
 //! Dynamic bodies collide through a reduced convex hull or, per object, a
@@ -32,6 +34,7 @@ pub mod roughness;
 mod spec;
 pub mod stand_in;
 mod sustain;
+pub mod transfer;
 mod validate;
 
 pub use collider::{DECOMPOSITION_CONCAVITY, DECOMPOSITION_RESOLUTION, MAX_HULL_VERTICES};
@@ -57,8 +60,8 @@ pub use render::{
 };
 pub use spec::{
     BodyKind, Channels, ColliderKind, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec,
-    MaterialSpec, MeshSource, ObjectSpec, RotationSpec, Scene, SurfaceSpec, AUTO_DECOMPOSITION_RATIO,
-    DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
+    MaterialSpec, MeshSource, ObjectSpec, Radiation, RotationSpec, Scene, SurfaceSpec,
+    AUTO_DECOMPOSITION_RATIO, DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
 };
 pub use sustain::{
     speed_gate, ContactEvent, SustainedEvent, SCRAPE_REFERENCE_SPEED_M_S, SUSTAIN_MIN_SPEED_M_S,

@@ -6,6 +6,15 @@
 //! from the physics trajectory (linear between physics steps) and linearly
 //! interpolated inside a block, so moving bodies glide without zipper noise.
 //! The fractional delay reads `s` with 4-point Catmull-Rom interpolation.
+//! An object heard through its acoustic transfer has one `s` per listening
+//! point (each ear and, with `ground_reflection`, its image; [`mix`]).
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use crate::spec::{Channels, Scene};
+use crate::transfer::image;
 
 /// Speed of sound in air [m/s].
 pub const SPEED_OF_SOUND_M_S: f64 = 343.0;
@@ -14,13 +23,16 @@ pub const MIN_DISTANCE_M: f64 = 0.1;
 /// Samples per gain/delay update.
 pub const BLOCK: usize = 64;
 
-/// An object's centre of mass sampled every physics step.
+/// An object's centre of mass and orientation sampled every physics step.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Trajectory {
     /// Time between samples [s].
     pub dt: f64,
     /// Positions at `k · dt` [m].
     pub positions: Vec<[f32; 3]>,
+    /// World-to-body rotation matrices at `k · dt` (rows: the body axes in
+    /// world coordinates); empty when not recorded.
+    pub rotations: Vec<[[f32; 3]; 3]>,
 }
 
 impl Trajectory {
@@ -37,6 +49,45 @@ impl Trajectory {
         let b = self.positions[(k + 1).min(n - 1)];
         [0, 1, 2].map(|c| a[c] as f64 + f * (b[c] as f64 - a[c] as f64))
     }
+}
+
+impl Trajectory {
+    /// `ear − p(t)` rotated into the body's frame at time `t` [m]: the
+    /// rotation is interpolated linearly between physics steps (a step turns
+    /// a body by at most a few hundredths of a radian, so the
+    /// interpolated matrix is orthogonal to ~1e-4) and the result rescaled
+    /// to the exact distance. Without recorded rotations, the world offset.
+    pub fn to_body_at(&self, t: f64, ear: [f64; 3]) -> [f64; 3] {
+        let p = self.at(t);
+        let w = [0, 1, 2].map(|c| ear[c] - p[c]);
+        let n = self.rotations.len();
+        if n == 0 {
+            return w;
+        }
+        let x = (t / self.dt).max(0.0);
+        let k = (x.floor() as usize).min(n - 1);
+        let f = if k + 1 < n { x - k as f64 } else { 0.0 };
+        let (a, b) = (self.rotations[k], self.rotations[(k + 1).min(n - 1)]);
+        let mut d = [0.0; 3];
+        for (r, row) in d.iter_mut().enumerate() {
+            *row = (0..3)
+                .map(|c| {
+                    let m = a[r][c] as f64 + f * (b[r][c] as f64 - a[r][c] as f64);
+                    m * w[c]
+                })
+                .sum();
+        }
+        let (len_w, len_d) = (norm(w), norm(d));
+        if len_d > 0.0 {
+            d.map(|v| v * len_w / len_d)
+        } else {
+            d
+        }
+    }
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -172,6 +223,59 @@ impl Block {
     }
 }
 
+/// Where the listener hears: each ear, followed by its image in the ground
+/// plane when `ground_reflection` is on (see [`crate::transfer`]).
+pub(crate) fn listening_points(scene: &Scene) -> Vec<[f64; 3]> {
+    let reflect = scene.ground.as_ref().filter(|_| scene.listener.ground_reflection);
+    ears(scene)
+        .into_iter()
+        .flat_map(|ear| std::iter::once(ear).chain(reflect.map(|g| image(ear, g.height_m))))
+        .collect()
+}
+
+/// Ear positions of the listener.
+pub(crate) fn ears(scene: &Scene) -> Vec<[f64; 3]> {
+    let l = &scene.listener;
+    match l.channels {
+        Channels::Mono => vec![l.position_m],
+        Channels::Stereo => {
+            let r = l.right;
+            let n = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+            let h = 0.5 * l.ear_spacing_m / n;
+            let p = l.position_m;
+            vec![
+                [p[0] - h * r[0], p[1] - h * r[1], p[2] - h * r[2]],
+                [p[0] + h * r[0], p[1] + h * r[1], p[2] + h * r[2]],
+            ]
+        }
+    }
+}
+
+pub(crate) fn mix(
+    scene: &Scene,
+    signals: &[(usize, &[Vec<f32>])],
+    paths: &[Arc<Trajectory>],
+    total: usize,
+) -> Vec<Vec<f32>> {
+    let fs = scene.sample_rate_hz as f64;
+    let points = listening_points(scene);
+    let per_ear = points.len() / ears(scene).len();
+    (0..points.len() / per_ear)
+        .into_par_iter()
+        .map(|e| {
+            let mut out = vec![0.0f32; total];
+            for ((start, samples), path) in signals.iter().zip(paths) {
+                for k in e * per_ear..(e + 1) * per_ear {
+                    // A single signal is heard at every point; else each point has its own.
+                    let s = if samples.len() == 1 { &samples[0] } else { &samples[k] };
+                    add_heard(s, *start, path, points[k], fs, scene.listener.gain, &mut out);
+                }
+            }
+            out
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -220,6 +324,7 @@ mod tests {
         let path = Trajectory {
             dt: 0.001,
             positions: (0..40).map(|k| [0.02 * k as f32, 0.5 - 0.01 * k as f32, 0.0]).collect(),
+            rotations: Vec::new(),
         };
         let s: Vec<f32> =
             (0..3000).map(|k| ((k as f32) * 0.05).sin() * (-(k as f32) / 900.0).exp()).collect();
@@ -248,7 +353,7 @@ mod tests {
         let fs = 48_000.0;
         let mut s = vec![0.0f32; 100];
         s[0] = 1.0;
-        let path = Trajectory { dt: 0.01, positions: vec![[0.0, 0.0, 0.0]; 3] };
+        let path = Trajectory { dt: 0.01, positions: vec![[0.0, 0.0, 0.0]; 3], rotations: Vec::new() };
         let ear = [3.43, 0.0, 0.0]; // 10 ms, 480 samples
         let mut out = vec![0.0f32; 2000];
         add_heard(&s, 100, &path, ear, fs, 1.0, &mut out);

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use modal_bank::ModeBank;
+use modal_bank::{ModeBank, RadiationTable};
 use modal_fem::Material;
 
 use crate::material::resolve_material;
@@ -82,6 +82,20 @@ pub trait BankProvider {
     fn provide(&mut self, request: &BankRequest) -> Result<ProvidedBank, ProviderError> {
         self.bank(request).map(ProvidedBank::Ready)
     }
+
+    /// The per-mode acoustic transfer of `bank` (the complete bank of
+    /// `request`): stored with it, cached, or solved now. `None`: the render
+    /// uses the level estimate for this asset. Called once per distinct
+    /// asset when the scene's listener asks for the transfer
+    /// (`[listener] radiation = "transfer"`); the default has none.
+    fn radiation(
+        &mut self,
+        request: &BankRequest,
+        bank: &Arc<ModeBank>,
+    ) -> Result<Option<Arc<RadiationTable>>, ProviderError> {
+        let _ = (request, bank);
+        Ok(None)
+    }
 }
 
 /// A provider serving fixed banks by generator name or file name, for tests
@@ -90,6 +104,7 @@ pub trait BankProvider {
 #[derive(Default)]
 pub struct InMemoryProvider {
     entries: Vec<(String, Arc<ModeBank>)>,
+    tables: Vec<(String, Arc<RadiationTable>)>,
     /// Requests served so far, in order.
     pub requests: Vec<BankRequest>,
 }
@@ -103,6 +118,12 @@ impl InMemoryProvider {
     /// Serves `bank` for requests with key `key`.
     pub fn insert(&mut self, key: impl Into<String>, bank: ModeBank) -> &mut Self {
         self.entries.push((key.into(), Arc::new(bank)));
+        self
+    }
+
+    /// Serves `table` as the radiation of the bank with key `key`.
+    pub fn insert_radiation(&mut self, key: impl Into<String>, table: RadiationTable) -> &mut Self {
+        self.tables.push((key.into(), Arc::new(table)));
         self
     }
 
@@ -127,6 +148,15 @@ impl BankProvider for InMemoryProvider {
             .map(|(_, b)| Arc::clone(b))
             .ok_or_else(|| format!("no in-memory bank named '{key}'").into())
     }
+
+    fn radiation(
+        &mut self,
+        request: &BankRequest,
+        _bank: &Arc<ModeBank>,
+    ) -> Result<Option<Arc<RadiationTable>>, ProviderError> {
+        let key = Self::key(request);
+        Ok(self.tables.iter().find(|(k, _)| Some(k) == key.as_ref()).map(|(_, t)| Arc::clone(t)))
+    }
 }
 
 /// The banks of a scene's objects: complete or light (see [`ProvidedBank`]).
@@ -136,12 +166,19 @@ pub(crate) struct ResolvedBanks {
     assets: Vec<(Arc<ModeBank>, Option<BankCompletion>, String)>,
     /// Per object, its asset.
     asset_of: Vec<usize>,
+    /// Per distinct asset, its request.
+    requests: Vec<BankRequest>,
 }
 
 impl ResolvedBanks {
     /// Distinct assets asked for.
     pub fn requested(&self) -> usize {
         self.assets.len()
+    }
+
+    /// Per distinct asset its request, and per object its asset.
+    pub fn requests(&self) -> (Vec<BankRequest>, Vec<usize>) {
+        (self.requests.clone(), self.asset_of.clone())
     }
 
     /// One bank per object (instances of an asset share one `Arc`); pending
@@ -206,7 +243,7 @@ pub(crate) fn resolve_banks(
         requests.push(request);
         assets.push((bank, rest, path));
     }
-    Ok(ResolvedBanks { assets, asset_of })
+    Ok(ResolvedBanks { assets, asset_of, requests })
 }
 
 /// The scene relies on a bank's surface and mass properties; reject banks it

@@ -18,7 +18,14 @@
 //! 4. **mix**: per object and ear, 1/r gain and r/c delay ([`crate::listener`]),
 //!    the ears in parallel.
 //!
-//! **Level.** Mode `i` radiates like a pulsating sphere of radius
+//! Between 2 and 3, **radiation**: with `[listener] radiation = "transfer"`
+//! the provider is asked once per distinct asset for its acoustic transfer
+//! table ([`crate::BankProvider::radiation`]); an object whose bank has one
+//! is synthesized once per listening point (ear, ground image), each voice
+//! weighted by the transfer in the body's rotating frame (module
+//! `transfer`, which states exactly what it replaces). The rest use:
+//!
+//! **Level estimate.** Mode `i` radiates like a pulsating sphere of radius
 //! `a = √(A/4π)` (the sphere with the object's surface area `A`) whose
 //! surface moves with the mode's RMS normal surface velocity `v_i`
 //! (`modal_synth::SynthModel::rms_normal_shapes`):
@@ -43,11 +50,12 @@ use serde::Serialize;
 
 use crate::excite::{Exciter, ImpactEvent, StepInput, StepStrikes, Strike};
 use crate::ground::with_slab;
-use crate::listener::{add_heard, Trajectory};
+use crate::listener::{listening_points, mix, Trajectory};
 use crate::physics::{check_ground_clearance, PairContacts, World};
 use crate::provider::resolve_banks;
-use crate::spec::{Channels, Scene};
+use crate::spec::{Radiation, Scene};
 use crate::sustain::{ContactEvent, SustainInput, SustainedEvent, Sustainer};
+use crate::transfer::{object_transfers, BankTransfer, EarTransfer, ModeLevel};
 use crate::{BankProvider, SceneError};
 
 /// Characteristic impedance of air ρ₀c [Pa·s/m] (20 °C).
@@ -93,8 +101,15 @@ pub struct ObjectReport {
     pub mode_samples: u64,
     /// Samples of the object's signal computed (0 if never hit).
     pub samples_computed: u64,
-    /// Peak of the object's radiated pressure at 1 m [Pa].
+    /// Peak of the object's radiated pressure at 1 m [Pa] (with the
+    /// transfer: the largest over its paths to the ears).
     pub peak_pa_at_1m: f64,
+    /// Modes heard through their acoustic transfer (the rest, if the object
+    /// sounded, through the level estimate).
+    pub modes_with_transfer: usize,
+    /// Per mode with a transfer: its level by the estimate and by the
+    /// transfer (what the transfer changed).
+    pub mode_levels: Vec<ModeLevel>,
     /// Centre of mass when the simulation ended (end of the scene, or when
     /// every body fell asleep) [m].
     pub final_position_m: [f64; 3],
@@ -123,6 +138,9 @@ pub struct RenderReport {
     pub excitation_s: f64,
     /// Seconds synthesizing the sustained-contact forces (roughness tracks).
     pub sustained_s: f64,
+    /// Seconds getting the banks' acoustic transfer from the provider
+    /// (stored, cached or solved now).
+    pub radiation_s: f64,
     /// Seconds in modal synthesis.
     pub synthesis_s: f64,
     /// Seconds in the listener mix.
@@ -199,6 +217,7 @@ pub fn render(
     let t = Instant::now();
     let resolved = resolve_banks(scene, provider)?;
     report.banks_requested = resolved.requested();
+    let (requests, asset_of) = resolved.requests();
     report.banks_s = t.elapsed().as_secs_f64();
     let light = resolved.light();
     check_ground_clearance(original, &light[..original.objects.len()])?;
@@ -217,17 +236,28 @@ pub fn render(
         },
     );
     let (banks, models) = completed?;
-    let sim = sim?;
+    let mut sim = sim?;
+    let paths: Vec<Arc<Trajectory>> =
+        std::mem::take(&mut sim.trajectories).into_iter().map(Arc::new).collect();
+
+    let per_object = shared_models(&banks, &names, &sim, models)?;
+    let t = Instant::now();
+    let transfers = if scene.listener.radiation == Radiation::Transfer {
+        object_transfers(provider, &requests, &asset_of, &banks, &per_object)?
+    } else {
+        vec![None; banks.len()]
+    };
+    report.radiation_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let fs = scene.sample_rate_hz as f64;
     let total = (scene.duration_s * fs).round() as usize;
-    let per_object = shared_models(&banks, &names, &sim, models)?;
-    let signals = synthesize(scene, &banks, &per_object, &sim, total)?;
+    let signals = synthesize(scene, &banks, &per_object, &transfers, &sim, &paths, total)?;
     report.synthesis_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let mut channels = mix(scene, &signals, &sim.trajectories, total);
+    let heard: Vec<(usize, &[Vec<f32>])> = signals.iter().map(|s| (s.start, &s.samples[..])).collect();
+    let mut channels = mix(scene, &heard, &paths, total);
     fade_out(&mut channels, (FADE_OUT_S * fs) as usize);
     report.mix_s = t.elapsed().as_secs_f64();
 
@@ -237,7 +267,7 @@ pub fn render(
             impacts: sim.impacts[i],
             strikes: sim.strikes[i].len(),
             force_segments: sim.segments[i].len(),
-            final_position_m: sim.trajectories[i].positions.last().map_or([0.0; 3], |p| p.map(f64::from)),
+            final_position_m: paths[i].positions.last().map_or([0.0; 3], |p| p.map(f64::from)),
             ..s.report.clone()
         });
     }
@@ -282,13 +312,16 @@ fn simulate(
         segments: vec![Vec::new(); n],
         sustained: Vec::new(),
         impacts: vec![0; n],
-        trajectories: vec![Trajectory { dt, positions: Vec::new() }; n],
+        trajectories: vec![Trajectory { dt, positions: Vec::new(), rotations: Vec::new() }; n],
         events: Vec::new(),
         events_total: 0,
     };
     let record = |world: &World, sim: &mut Simulation| {
         for (i, path) in sim.trajectories.iter_mut().enumerate() {
             path.positions.push(world.center_of_mass(i).map(|x| x as f32));
+            // Rows: the world axes seen in the body frame, transposed = body-from-world.
+            let cols = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| world.to_body(i, e));
+            path.rotations.push([0, 1, 2].map(|r| [0, 1, 2].map(|c| cols[c][r] as f32)));
         }
     };
     record(&world, &mut sim);
@@ -360,35 +393,39 @@ fn simulate(
 
 /// One object's radiated signal at 1 m and its statistics.
 struct Signal {
-    /// Output sample index of `samples[0]`.
+    /// Output sample index of `samples[k][0]`.
     start: usize,
-    /// Pressure at 1 m divided by [`FULL_SCALE_PA`].
-    samples: Vec<f32>,
+    /// Pressure at 1 m divided by [`FULL_SCALE_PA`]: one signal heard at
+    /// every listening point (level estimate), or one per listening point
+    /// ([`listening_points`], with the transfer).
+    samples: Vec<Vec<f32>>,
     report: ObjectReport,
 }
 
 /// A checked synthesis model and its radiation gains, shared by instances.
-type SharedModel = (Arc<SynthModel>, Arc<Vec<f64>>);
+pub(crate) type SharedModel = (Arc<SynthModel>, Arc<Vec<f64>>);
 
 fn synthesize(
     scene: &Scene,
     banks: &[Arc<ModeBank>],
     per_object: &[Option<SharedModel>],
+    transfers: &[Option<Arc<BankTransfer>>],
     sim: &Simulation,
+    paths: &[Arc<Trajectory>],
     total: usize,
 ) -> Result<Vec<Signal>, SceneError> {
-    let paths = &sim.trajectories;
     let names = |i: usize| scene.object_name(i);
     let fs = scene.sample_rate_hz as f64;
-    let ears = ears(scene);
+    let ears = listening_points(scene);
     // Phase 1: every struck voice up to its last strike (its peak is known then).
     let mut runs: Vec<Option<VoiceRun>> = (0..banks.len())
         .into_par_iter()
         .map(|i| -> Result<Option<VoiceRun>, SceneError> {
             let Some((model, gains)) = &per_object[i] else { return Ok(None) };
+            let transfer = transfers[i].as_ref();
             let opts = SynthOptions {
                 sample_rate: fs,
-                gain: OutputGain::PerMode(gains.to_vec()),
+                gain: OutputGain::PerMode(transfer.map_or_else(|| gains.to_vec(), |t| t.gains.clone())),
                 parallel: false,
                 ..SynthOptions::default()
             };
@@ -401,12 +438,32 @@ fn synthesize(
             } else {
                 Some(DrivenVoice::from_model(Arc::clone(model), opts.clone()).map_err(failed)?)
             };
-            let voice = ModalVoice::from_model(Arc::clone(model), opts).map_err(failed)?;
-            let scale = AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA;
+            let voices = match transfer {
+                // One voice per listening point, each with its own direction.
+                Some(t) => ears
+                    .iter()
+                    .map(|&ear| {
+                        let mut v = ModalVoice::from_model(Arc::clone(model), opts.clone())?;
+                        v.set_modulation(Arc::new(EarTransfer::new(
+                            Arc::clone(t),
+                            Arc::clone(&paths[i]),
+                            ear,
+                        )));
+                        Ok(v)
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(failed)?,
+                None => vec![ModalVoice::from_model(Arc::clone(model), opts).map_err(failed)?],
+            };
+            // The transfer's gains are in Pa·m already; the estimate's are RMS velocities.
+            let scale = match transfer {
+                Some(_) => 1.0 / FULL_SCALE_PA,
+                None => AIR_IMPEDANCE_PA_S_M * equivalent_radius(&banks[i]) / FULL_SCALE_PA,
+            };
             let (near_m, far_m) = distance_range(&paths[i], &ears);
             let place = Placement { total, fs, scale, near_m, far_m };
             let excitation = Excitation { strikes: &sim.strikes[i], segments: &sim.segments[i] };
-            Ok(VoiceRun::start(voice, driven, excitation, &place).map(|mut run| {
+            Ok(VoiceRun::start(voices, driven, excitation, &place).map(|mut run| {
                 run.render_strikes(total);
                 run
             }))
@@ -424,10 +481,15 @@ fn synthesize(
         .into_iter()
         .enumerate()
         .map(|(i, run)| {
-            let report = ObjectReport { modes_total: banks[i].mode_count(), ..Default::default() };
+            let report = ObjectReport {
+                modes_total: banks[i].mode_count(),
+                modes_with_transfer: transfers[i].as_ref().map_or(0, |t| t.with_transfer),
+                mode_levels: transfers[i].as_ref().map_or_else(Vec::new, |t| t.levels.clone()),
+                ..Default::default()
+            };
             match run {
                 Some(run) => run.finish(report),
-                None => Signal { start: 0, samples: Vec::new(), report },
+                None => Signal { start: 0, samples: vec![Vec::new()], report },
             }
         })
         .collect())
@@ -514,7 +576,7 @@ fn radiation_gains(model: &SynthModel, bank: &ModeBank) -> Vec<f64> {
 }
 
 /// Radius of the sphere with the same surface area [m].
-fn equivalent_radius(bank: &ModeBank) -> f64 {
+pub(crate) fn equivalent_radius(bank: &ModeBank) -> f64 {
     let p = &bank.surface.positions;
     let area: f64 = bank
         .surface
@@ -551,9 +613,11 @@ struct Excitation<'a> {
 }
 
 /// A voice (impulses, and sustained forces if any) being rendered in
-/// chunks of [`RENDER_CHUNK`] samples.
+/// chunks of [`RENDER_CHUNK`] samples: one impulse voice heard at every
+/// listening point, or one per listening point (transfer); the sustained
+/// forces' voice is shared by all (direction-averaged level).
 struct VoiceRun {
-    voice: ModalVoice,
+    voices: Vec<ModalVoice>,
     driven: Option<DrivenVoice>,
     /// Output sample index of `samples[0]`.
     start: usize,
@@ -561,8 +625,10 @@ struct VoiceRun {
     pos: usize,
     /// The sample after which no strike or force is pending.
     last_sample: usize,
-    /// Voice output so far (synthesizer units).
-    samples: Vec<f32>,
+    /// Output of each voice so far (synthesizer units).
+    samples: Vec<Vec<f32>>,
+    /// The sustained-force voice's chunk, when several voices share it.
+    scratch: Vec<f32>,
     /// Largest |sample| so far (synthesizer units).
     peak: f32,
     /// Synthesizer units → pressure at 1 m / [`FULL_SCALE_PA`].
@@ -577,19 +643,28 @@ struct VoiceRun {
 impl VoiceRun {
     /// Applies the strikes and forces; `None` when none of them landed.
     fn start(
-        mut voice: ModalVoice,
+        mut voices: Vec<ModalVoice>,
         mut driven: Option<DrivenVoice>,
         excitation: Excitation<'_>,
         place: &Placement,
     ) -> Option<VoiceRun> {
         let (mut first, mut last, mut dropped) = (f64::INFINITY, 0.0f64, 0);
         for s in excitation.strikes {
-            match voice.add_impulse(s.time_s, s.point_m, s.impulse_ns, s.contact_time_s) {
-                Ok(_) => {
+            let mut landed = None;
+            for voice in &mut voices {
+                // Every voice has the same model: a strike lands on all or none.
+                let at = landed.unwrap_or(modal_synth::ImpactPoint::Position(s.point_m));
+                match voice.add_impulse(s.time_s, at, s.impulse_ns, s.contact_time_s) {
+                    Ok(p) => landed = Some(p.into()),
+                    Err(_) => break,
+                }
+            }
+            match landed {
+                Some(_) => {
                     first = first.min(s.time_s);
                     last = last.max(s.time_s + s.contact_time_s);
                 }
-                Err(_) => dropped += 1,
+                None => dropped += 1,
             }
         }
         let mut segments_dropped = 0;
@@ -610,12 +685,13 @@ impl VoiceRun {
         let start = ((first * place.fs).floor() as usize).min(total);
         let last_sample = (last * place.fs).ceil() as usize + 1;
         let run = VoiceRun {
-            voice,
+            samples: vec![Vec::new(); voices.len()],
+            scratch: Vec::new(),
+            voices,
             driven,
             start,
             pos: start,
             last_sample,
-            samples: Vec::new(),
             peak: 0.0,
             scale: place.scale,
             near_m: place.near_m,
@@ -627,19 +703,31 @@ impl VoiceRun {
     }
 
     fn is_silent(&self) -> bool {
-        self.voice.is_silent() && self.driven.as_ref().is_none_or(DrivenVoice::is_silent)
+        self.voices.iter().all(ModalVoice::is_silent)
+            && self.driven.as_ref().is_none_or(DrivenVoice::is_silent)
     }
 
-    /// Renders one chunk; returns its peak.
+    /// Renders one chunk; returns its peak (over every voice).
     fn chunk(&mut self, total: usize) -> f32 {
         let len = RENDER_CHUNK.min(total - self.pos);
-        let at = self.samples.len();
-        self.samples.resize(at + len, 0.0);
-        self.voice.render(&mut self.samples[at..], self.pos as u64);
-        if let Some(d) = self.driven.as_mut() {
-            d.render(&mut self.samples[at..], self.pos as u64);
+        let at = self.samples[0].len();
+        for (voice, samples) in self.voices.iter_mut().zip(&mut self.samples) {
+            samples.resize(at + len, 0.0);
+            voice.render(&mut samples[at..], self.pos as u64);
         }
-        let block_peak = self.samples[at..].iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        if let Some(d) = self.driven.as_mut() {
+            if let [only] = &mut self.samples[..] {
+                d.render(&mut only[at..], self.pos as u64);
+            } else {
+                self.scratch.clear();
+                self.scratch.resize(len, 0.0);
+                d.render(&mut self.scratch, self.pos as u64);
+                for samples in &mut self.samples {
+                    samples[at..].iter_mut().zip(&self.scratch).for_each(|(y, x)| *y += x);
+                }
+            }
+        }
+        let block_peak = self.samples.iter().flat_map(|s| &s[at..]).fold(0.0f32, |m, x| m.max(x.abs()));
         self.peak = self.peak.max(block_peak);
         self.pos += len;
         block_peak
@@ -659,13 +747,15 @@ impl VoiceRun {
             if self.is_silent() {
                 return;
             }
-            let at = self.samples.len();
+            let at = self.samples[0].len();
             if (self.chunk(total) as f64) <= floor {
-                let tail = &mut self.samples[at..];
-                let n = tail.len();
-                for (j, x) in tail.iter_mut().enumerate() {
-                    let g = 0.5 * (1.0 + (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos());
-                    *x = (*x as f64 * g) as f32;
+                for samples in &mut self.samples {
+                    let tail = &mut samples[at..];
+                    let n = tail.len();
+                    for (j, x) in tail.iter_mut().enumerate() {
+                        let g = 0.5 * (1.0 + (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos());
+                        *x = (*x as f64 * g) as f32;
+                    }
                 }
                 return;
             }
@@ -673,50 +763,19 @@ impl VoiceRun {
     }
 
     fn finish(mut self, mut report: ObjectReport) -> Signal {
-        for x in &mut self.samples {
+        for x in self.samples.iter_mut().flatten() {
             *x = (*x as f64 * self.scale) as f32;
         }
-        let stats = self.voice.stats();
+        let stats = self.voices[0].stats();
         report.strikes_dropped = self.strikes_dropped;
         report.force_segments_dropped = self.segments_dropped;
         report.modes_synthesized = stats.modes_total - stats.modes_skipped;
-        report.mode_samples = stats.mode_samples + self.driven.as_ref().map_or(0, |d| d.stats().mode_samples);
-        report.samples_computed = self.samples.len() as u64;
+        report.mode_samples = self.voices.iter().map(|v| v.stats().mode_samples).sum::<u64>()
+            + self.driven.as_ref().map_or(0, |d| d.stats().mode_samples);
+        report.samples_computed = self.samples[0].len() as u64;
         report.peak_pa_at_1m = self.peak as f64 * self.scale * FULL_SCALE_PA;
         Signal { start: self.start, samples: self.samples, report }
     }
-}
-
-/// Ear positions of the listener.
-fn ears(scene: &Scene) -> Vec<[f64; 3]> {
-    let l = &scene.listener;
-    match l.channels {
-        Channels::Mono => vec![l.position_m],
-        Channels::Stereo => {
-            let r = l.right;
-            let n = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-            let h = 0.5 * l.ear_spacing_m / n;
-            let p = l.position_m;
-            vec![
-                [p[0] - h * r[0], p[1] - h * r[1], p[2] - h * r[2]],
-                [p[0] + h * r[0], p[1] + h * r[1], p[2] + h * r[2]],
-            ]
-        }
-    }
-}
-
-fn mix(scene: &Scene, signals: &[Signal], paths: &[Trajectory], total: usize) -> Vec<Vec<f32>> {
-    let fs = scene.sample_rate_hz as f64;
-    ears(scene)
-        .into_par_iter()
-        .map(|ear| {
-            let mut out = vec![0.0f32; total];
-            for (s, path) in signals.iter().zip(paths) {
-                add_heard(&s.samples, s.start, path, ear, fs, scene.listener.gain, &mut out);
-            }
-            out
-        })
-        .collect()
 }
 
 fn fade_out(channels: &mut [Vec<f32>], len: usize) {

@@ -86,6 +86,29 @@ pub struct ListenerSpec {
     /// Extra linear output gain (`gain`, default 1).
     #[serde(default = "defaults::one")]
     pub gain: f64,
+    /// How each mode's level at an ear is found (`radiation`, default
+    /// `"transfer"`): see [`Radiation`].
+    #[serde(default)]
+    pub radiation: Radiation,
+    /// Add the ground plane's reflection as one image source per ear
+    /// (`ground_reflection`, default false; needs a `[ground]` plane).
+    #[serde(default)]
+    pub ground_reflection: bool,
+}
+
+/// How the listener hears each mode (`[listener] radiation`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Radiation {
+    /// Each mode's complex acoustic transfer (the bank's radiation table,
+    /// from the provider: stored, cached or solved on demand), per ear, in
+    /// the body's rotating frame, updated every block; the estimate for
+    /// banks the provider has no table for.
+    #[default]
+    Transfer,
+    /// The direction-free level estimate (a pulsating sphere of the
+    /// object's area with the mode's RMS normal velocity).
+    Estimate,
 }
 
 impl Default for ListenerSpec {
@@ -96,6 +119,8 @@ impl Default for ListenerSpec {
             ear_spacing_m: defaults::ear_spacing(),
             right: defaults::right(),
             gain: 1.0,
+            radiation: Radiation::default(),
+            ground_reflection: false,
         }
     }
 }

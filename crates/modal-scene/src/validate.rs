@@ -52,6 +52,12 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
     non_negative("listener.ear_spacing", l.ear_spacing_m)?;
     nonzero3("listener.right", l.right)?;
     non_negative("listener.gain", l.gain)?;
+    if l.ground_reflection && scene.ground.as_ref().is_none_or(|g| g.size_m.is_some()) {
+        return Err(SceneError::invalid(
+            "listener.ground_reflection",
+            "needs a [ground] plane (a ground without `size`): the reflection is that of an infinite rigid plane",
+        ));
+    }
     if let Some(g) = &scene.ground {
         finite("ground.height", g.height_m)?;
         resolve_material(&g.material).map_err(|m| SceneError::invalid("ground.material", m))?;

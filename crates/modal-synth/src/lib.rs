@@ -26,6 +26,7 @@ pub mod force;
 pub mod force_kernel;
 pub mod kernel;
 mod model;
+pub mod modulation;
 mod offline;
 mod options;
 pub mod reference;
@@ -42,6 +43,7 @@ pub use contact::{
 pub use error::SynthError;
 pub use force::{DrivenStats, DrivenVoice, ForceSegment};
 pub use model::{SynthModel, MAX_SNAP_FRACTION};
+pub use modulation::OutputModulation;
 pub use offline::{
     auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,
     MIN_AUTO_DURATION_S,

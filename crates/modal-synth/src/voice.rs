@@ -26,6 +26,13 @@
 //! position, with the phase and decay they would have had; the part of the
 //! output before the current position is lost).
 //!
+//! Modulation ([`ModalVoice::set_modulation`], module `modulation`): the
+//! output weights may carry time-varying complex factors `m_i(t)`,
+//! `y = Σ_i Re(m_i W_i z_i)`, evaluated at block edges and interpolated
+//! geometrically inside a block (the kernel then runs `m u` with pole `ρ p`).
+//! The f64 anchors, the grid states and the culling stay unmodulated; the
+//! current state at an event is then taken exactly from the anchor.
+//!
 //! Culling: at every grid point a mode whose amplitude `|u|` there is below
 //! `10^{cull_db/20}` times the loudest active mode, or below the absolute
 //! floor [`ABSOLUTE_FLOOR`], leaves the active set for good (its state is
@@ -44,6 +51,7 @@ use crate::contact::{half_sine_spectrum, MAX_CONTACT_TIME_S};
 use crate::error::SynthError;
 use crate::kernel::{self, LaneBuf, SimdPath, CHUNK, LANES, TILE};
 use crate::model::SynthModel;
+use crate::modulation::{Modulation, OutputModulation};
 use crate::options::{classify_mode, Kernel, OutputQuantity, SkipReason, SynthOptions};
 use crate::surface::SurfacePoint;
 use modal_bank::ModeBank;
@@ -223,6 +231,9 @@ pub struct ModalVoice {
     modal: Vec<f64>,
     chunks: Vec<ChunkScratch>,
     seg64: Vec<f64>,
+    /// Time-varying complex factors on the output weights.
+    modulation: Option<Modulation>,
+    ramp: Vec<(C64, C64)>,
 }
 
 impl ModalVoice {
@@ -292,6 +303,8 @@ impl ModalVoice {
             modal: vec![0.0; n],
             chunks: Vec::new(),
             seg64: Vec::new(),
+            modulation: None,
+            ramp: Vec::new(),
             opts,
         };
         if let Some(g) = voice.model.initial_gains(&voice.opts.gain)? {
@@ -310,6 +323,16 @@ impl ModalVoice {
             self.modes.w[i] = weight(self.opts.quantity, self.modes.s[i], gi);
         }
         self.gains_set = true;
+    }
+
+    /// Multiplies each mode's output weight by the complex factor
+    /// `source` gives as a function of time (module doc; e.g. the acoustic
+    /// transfer to an ear of a moving body). Takes effect at the current
+    /// position: the active modes are reloaded.
+    pub fn set_modulation(&mut self, source: Arc<dyn OutputModulation>) {
+        self.modulation = Some(Modulation::new(source));
+        let pos = self.pos;
+        self.jump_to_sample(pos);
     }
 
     /// The shared model.
@@ -484,6 +507,15 @@ impl ModalVoice {
     /// Applies `ev` at the current position: anchors plus current state.
     fn apply_event(&mut self, ev: &Event) {
         self.anchor_event(ev);
+        if self.modulation.is_some() {
+            // The kernel state is modulated: take the current state exactly
+            // from the anchors (which now include `ev`).
+            self.current_from_anchor();
+            self.all_candidates();
+            self.select_active();
+            self.exact_next = true;
+            return;
+        }
         self.scatter_current();
         let dt = self.pos as f64 / self.fs - ev.tc;
         for i in 0..self.model.mode_count() {
@@ -495,6 +527,16 @@ impl ModalVoice {
         self.all_candidates();
         self.select_active();
         self.exact_next = true;
+    }
+
+    /// `cur = anchor · e^{s (t − t_anchor)}` at the current position for
+    /// every mode with a nonzero anchor (exact in f64).
+    fn current_from_anchor(&mut self) {
+        let t = self.pos as f64 / self.fs - self.t_anchor;
+        for i in 0..self.model.mode_count() {
+            let a = self.modes.anchor[i];
+            self.cur[i] = if a == C64::ZERO { a } else { a * self.modes.s[i].scale(t).exp() };
+        }
     }
 
     /// Copies the kernel state of active modes into `cur` (all other
@@ -573,8 +615,16 @@ impl ModalVoice {
             v.clear();
         }
         let reference = self.path.is_none();
+        if let Some(m) = self.modulation.as_mut() {
+            m.ramp(self.pos, self.fs, &idx, &mut self.ramp);
+        }
+        let modulated = self.modulation.is_some();
         for (k, &i) in idx.iter().enumerate() {
-            let (u, p) = (self.cur[i], self.modes.pole[i]);
+            let (mut u, mut p) = (self.cur[i], self.modes.pole[i]);
+            if modulated {
+                let (m, rho) = self.ramp[k];
+                (u, p) = (m * u, p * rho);
+            }
             a.r32[k] = u.re as f32;
             a.i32[k] = u.im as f32;
             a.pr32[k] = p.re as f32;
@@ -634,11 +684,7 @@ impl ModalVoice {
             }
         }
         self.pos = n;
-        let t = n as f64 / self.fs - self.t_anchor;
-        for i in 0..self.model.mode_count() {
-            let a = self.modes.anchor[i];
-            self.cur[i] = if a == C64::ZERO { a } else { a * self.modes.s[i].scale(t).exp() };
-        }
+        self.current_from_anchor();
         self.all_candidates();
         self.select_active();
         self.exact_next = true;
@@ -734,7 +780,12 @@ impl ModalVoice {
     pub(crate) fn envelope_terms(&mut self) -> Vec<(f64, f64, f64)> {
         let mut terms = Vec::new();
         let t_now = self.pos as f64 / self.fs;
-        self.scatter_current();
+        if self.modulation.is_some() {
+            // Every nonzero anchor belongs to an active mode (select_active).
+            self.current_from_anchor();
+        } else {
+            self.scatter_current();
+        }
         for &i in &self.active.idx {
             terms.push((t_now, -self.modes.s[i].re, self.cur[i].abs()));
             self.cur[i] = C64::ZERO;
