@@ -541,27 +541,7 @@ fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
 
 /// Nodes on faces that belong to exactly one tet, sorted.
 fn boundary_nodes(tets: &[[usize; 4]]) -> Vec<usize> {
-    let mut faces: Vec<[usize; 3]> = Vec::with_capacity(4 * tets.len());
-    for t in tets {
-        for skip in 0..4 {
-            let mut f = [t[(skip + 1) % 4], t[(skip + 2) % 4], t[(skip + 3) % 4]];
-            f.sort_unstable();
-            faces.push(f);
-        }
-    }
-    faces.sort_unstable();
-    let mut nodes = Vec::new();
-    let mut i = 0;
-    while i < faces.len() {
-        let mut j = i + 1;
-        while j < faces.len() && faces[j] == faces[i] {
-            j += 1;
-        }
-        if j - i == 1 {
-            nodes.extend(faces[i]);
-        }
-        i = j;
-    }
+    let mut nodes: Vec<usize> = boundary_faces(tets).into_iter().flatten().collect();
     nodes.sort_unstable();
     nodes.dedup();
     nodes
