@@ -375,7 +375,7 @@ pub fn tetrahedralize(
     let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     let feature_nodes_snapped = if options.preserve_features {
-        let (segments, corners) = features(&repaired.vertices, &repaired.triangles);
+        let (segments, corners) = features(&repaired.vertices, &repaired.triangles, &bvh, h);
         snap(&mut stuffed.nodes, &stuffed.tets, &boundary, &segments, &corners, h)
     } else {
         0
