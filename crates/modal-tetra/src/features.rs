@@ -48,7 +48,12 @@ const MAX_PIECES: usize = 64;
 /// Feature edges (as segments) and corners of an oriented triangle surface
 /// that lie on the boundary of the solid `bvh` bounds (see the module doc);
 /// `h` is the cell size.
-pub(crate) fn features(vertices: &[V3], triangles: &[[usize; 3]], bvh: &Bvh, h: f64) -> (Vec<[V3; 2]>, Vec<V3>) {
+pub(crate) fn features(
+    vertices: &[V3],
+    triangles: &[[usize; 3]],
+    bvh: &Bvh,
+    h: f64,
+) -> (Vec<[V3; 2]>, Vec<V3>) {
     let normal = |t: &[usize; 3]| {
         let n = cross(sub(vertices[t[1]], vertices[t[0]]), sub(vertices[t[2]], vertices[t[0]]));
         let l = norm(n);
