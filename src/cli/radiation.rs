@@ -34,9 +34,13 @@ pub struct RadiationArgs {
     /// Only these modes (indices into the bank; repeatable); default: every audible mode.
     #[arg(long, value_name = "I")]
     pub mode: Vec<usize>,
-    /// Solve every mode on the full panel mesh (no coarser panels at low frequency).
+    /// Solve every mode on the full panel mesh (no coarser panels or pressure clusters).
     #[arg(long)]
     pub full_resolution: bool,
+    /// Pressure cluster size κ: clusters of diameter κ / max(k, k_s), k the
+    /// acoustic and k_s the mode's surface wavenumber (smaller: finer, dearer).
+    #[arg(long, value_name = "KAPPA", default_value_t = modal_radiation::modes::DEFAULT_CLUSTER_KH)]
+    pub cluster_kh: f64,
     /// Also write a copy of the bank with every solved mode's far-field
     /// representation stored in it (format version 2), for `info`, `strike`.
     #[arg(long, value_name = "OUT.bank")]
@@ -89,6 +93,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     let air = Air { density_kg_m3: args.air_density, sound_speed_m_s: args.sound_speed };
     air.validate()?;
     ensure!(args.max_freq > 0.0, "--max-freq must be positive");
+    ensure!(args.cluster_kh.is_finite() && args.cluster_kh > 0.0, "--cluster-kh must be finite and positive");
     let mesh = modal_radiation::modes::boundary_mesh(&bank).context("the bank's surface cannot be used")?;
     for p in &args.point {
         ensure!(
@@ -115,8 +120,12 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         mesh.len(),
         skipped.len()
     );
-    let opts =
-        RadiationOptions { air, adaptive_resolution: !args.full_resolution, ..RadiationOptions::default() };
+    let opts = RadiationOptions {
+        air,
+        adaptive_resolution: !args.full_resolution,
+        cluster_kh: args.cluster_kh,
+        ..RadiationOptions::default()
+    };
     let results =
         modal_radiation::modes::radiate_modes_on(&bank, &mesh, &modes, &opts, &mut |p| eprintln!("{p}"))?;
     let mut out = Vec::with_capacity(results.len());

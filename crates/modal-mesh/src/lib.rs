@@ -26,6 +26,7 @@
 
 mod closest;
 mod error;
+mod icosphere;
 mod measure;
 mod overlap;
 mod parts;
@@ -40,6 +41,7 @@ pub mod io;
 
 pub use closest::closest_point_on_triangle;
 pub use error::{Location, MeshError};
+pub use icosphere::icosphere;
 pub use io::{read_mesh, write_msh41, write_msh41_file};
 pub use measure::{mesh_volume, tet_volume};
 pub use parts::{describe_hinges, face_parts, split_hinges, FaceParts, Hinge};

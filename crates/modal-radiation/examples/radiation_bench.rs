@@ -9,10 +9,10 @@ use std::time::Instant;
 use modal_radiation::special::{
     lm_index, spherical_hankel, spherical_hankel_derivative, spherical_harmonics,
 };
-use modal_radiation::{c64, multipole, shapes, solve, Air, BoundaryMesh, Formulation};
+use modal_radiation::{c64, multipole, solve, Air, BoundaryMesh, Formulation};
 
 fn main() {
-    let max_subdiv: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let max_subdiv: u32 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(3);
     let a = 0.1;
     let air = Air::default();
     println!(
@@ -20,7 +20,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|");
     for subdiv in 2..=max_subdiv {
-        let (v, t) = shapes::icosphere(subdiv);
+        let (v, t) = modal_mesh::icosphere(subdiv);
         let mesh = BoundaryMesh::new(v.iter().map(|p| p.map(|x| a * x)).collect(), &t).unwrap();
         let h = mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max);
         for ka in [0.5, 2.0, 6.0] {

@@ -17,11 +17,14 @@
 //! `(½ − K − αN) p = −(L + α(½ + K')) q` with `α = i/k`, which has a
 //! unique solution at every `k > 0` because `Im α ≠ 0`.
 //!
-//! Discretisation: piecewise-constant `p`, `q` on flat panels, collocation
-//! at panel centroids, dense complex LU with partial pivoting (faer,
-//! sequential, so the result does not depend on the thread count). Rows are
-//! assembled independently in parallel (rayon), each by one thread in a
-//! fixed order: bit-identical across thread counts.
+//! Discretisation: piecewise-constant `q` on flat panels; `p` piecewise
+//! constant on the panels or on clusters of panels ([`crate::cluster`]:
+//! fewer unknowns where the wavelength allows, every panel still
+//! integrated exactly as before), collocation at one panel centroid per
+//! cluster, dense complex LU with partial pivoting (faer, sequential, so
+//! the result does not depend on the thread count). Rows are assembled
+//! independently in parallel (rayon), each by one thread in a fixed order:
+//! bit-identical across thread counts.
 
 use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -29,9 +32,10 @@ use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::{Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
+use crate::cluster::Clusters;
 use crate::error::RadiationError;
-use crate::geometry::BoundaryMesh;
-use crate::kernels::Kernels;
+use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
+use crate::kernels::{Kernels, PanelIntegrals};
 
 /// Properties of the air.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -147,6 +151,23 @@ pub fn solve(
     velocities: &[Vec<c64>],
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
+    solve_clustered(mesh, &Clusters::identity(mesh.len()), air, frequency_hz, velocities, formulation)
+}
+
+/// [`solve`] with the pressure constant on each cluster of `clusters` (one
+/// unknown and one collocation point per cluster); the returned fields
+/// hold the pressure per panel (its cluster's value).
+pub fn solve_clustered(
+    mesh: &BoundaryMesh,
+    clusters: &Clusters,
+    air: Air,
+    frequency_hz: f64,
+    velocities: &[Vec<c64>],
+    formulation: Formulation,
+) -> Result<Vec<SurfaceField>, RadiationError> {
+    if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
+        return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
+    }
     air.validate()?;
     if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
         return Err(RadiationError::BadFrequency(frequency_hz));
@@ -161,31 +182,100 @@ pub fn solve(
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
-    let (mut at, mut rhs) = assemble(mesh, k, formulation, velocities, iwr);
-    let pressures =
-        lu_solve_transposed(&mut at, n, &mut rhs, nrhs).ok_or(RadiationError::Singular { frequency_hz })?;
+    let (mut at, mut rhs) = assemble(mesh, clusters, k, formulation, velocities, iwr);
+    let pressures = lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs)
+        .ok_or(RadiationError::Singular { frequency_hz })?;
     Ok((0..nrhs)
         .map(|f| SurfaceField {
             frequency_hz,
             wavenumber: k,
             air,
-            pressure: pressures.col(f).iter().copied().collect(),
+            pressure: clusters.of_panel.iter().map(|&c| pressures[(c, f)]).collect(),
             normal_velocity: velocities[f].clone(),
         })
         .collect())
 }
 
-/// Row `i` of the system matrix `A` is stored as column `i` of `at`
-/// (column-major `n × n`), i.e. `at = Aᵀ`. The right-hand sides come back
-/// row-major `n × nrhs`.
+/// A cluster seen as a test region: its panels with area weights, its
+/// area-weighted centre and normal, and its radius about the centre.
+struct TestRegion {
+    members: Vec<(usize, f64)>,
+    centre: [f64; 3],
+    normal: [f64; 3],
+    radius: f64,
+}
+
+fn test_regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<TestRegion> {
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); clusters.len()];
+    for (p, &c) in clusters.of_panel.iter().enumerate() {
+        members[c].push(p);
+    }
+    members
+        .into_iter()
+        .map(|m| {
+            let area: f64 = m.iter().map(|&p| mesh.panels[p].area).sum();
+            let mean = |f: &dyn Fn(usize) -> [f64; 3]| {
+                [0, 1, 2].map(|k| m.iter().map(|&p| mesh.panels[p].area * f(p)[k]).sum::<f64>() / area)
+            };
+            let centre = mean(&|p| mesh.panels[p].centroid);
+            let n = mean(&|p| mesh.panels[p].normal);
+            let len = norm(n);
+            let radius = m
+                .iter()
+                .map(|&p| norm(sub(mesh.panels[p].centroid, centre)) + mesh.panels[p].diameter)
+                .fold(0.0, f64::max);
+            let members = m.iter().map(|&p| (p, mesh.panels[p].area / area)).collect();
+            TestRegion { members, centre, normal: n.map(|x| x / len), radius }
+        })
+        .collect()
+}
+
+/// Panels closer than this many (cluster radius + panel diameter) to a
+/// cluster's centre are tested at every member centroid; farther ones at
+/// the cluster's centre alone (the mean of a smooth kernel over the
+/// cluster, to second order in its size).
+pub const CLUSTER_NEAR_RATIO: f64 = 1.5;
+
+/// Panels farther than this many diameters from the point (and with
+/// `k·h ≤ 1`) are integrated by their centroid alone: relative error
+/// `O((h/r)²)` of the smooth kernel, below 1 % at this ratio.
+pub const FAR_POINT_RATIO: f64 = 8.0;
+
+/// The four panel integrals of `panel` seen from `x`: one centroid point
+/// when far ([`FAR_POINT_RATIO`]), the adaptive rule otherwise.
+fn integrals(
+    kern: &Kernels,
+    mesh: &BoundaryMesh,
+    panel: &Panel,
+    x: [f64; 3],
+    nx: [f64; 3],
+) -> PanelIntegrals {
+    let d = sub(panel.centroid, x);
+    let far = FAR_POINT_RATIO * panel.diameter;
+    if dot(d, d) > far * far && kern.k() * panel.diameter <= 1.0 {
+        kern.point(x, nx, panel.centroid, panel.normal, panel.area)
+    } else {
+        kern.panel(mesh, panel, x, nx)
+    }
+}
+
+/// Row `i` (cluster `i`) of the system matrix `A` is stored as column `i`
+/// of `at` (column-major `n × n`, `n` clusters), i.e. `at = Aᵀ`. The
+/// equation of a cluster is the area-weighted mean of the collocation
+/// equations at its panels' centroids (each balanced about its own panel,
+/// which a single off-centre point of the hypersingular equation is not);
+/// entry `(i, c)` sums the integrals over the panels of cluster `c`. A
+/// single panel per cluster is plain centroid collocation. The right-hand
+/// sides come back row-major `n × nrhs`.
 fn assemble(
     mesh: &BoundaryMesh,
+    clusters: &Clusters,
     k: f64,
     formulation: Formulation,
     velocities: &[Vec<c64>],
     iwr: c64,
 ) -> (Vec<c64>, Vec<c64>) {
-    let n = mesh.len();
+    let n = clusters.len();
     let nrhs = velocities.len();
     let alpha = match formulation {
         Formulation::BurtonMiller => c64::new(0.0, 1.0 / k),
@@ -193,20 +283,35 @@ fn assemble(
     };
     let kern = Kernels::new(k);
     let zero = c64::new(0.0, 0.0);
+    let regions = test_regions(mesh, clusters);
     let mut at = vec![zero; n * n];
     let mut rhs = vec![zero; n * nrhs];
     at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
-        let pi = &mesh.panels[i];
+        let region = &regions[i];
+        let single = region.members.len() == 1;
         for (j, pj) in mesh.panels.iter().enumerate() {
-            let ints = if i == j {
-                kern.self_integrals(mesh, pj)
+            let near = single
+                || norm(sub(pj.centroid, region.centre)) < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter);
+            let (mut a, mut op) = (zero, zero);
+            if near {
+                for &(t, w) in &region.members {
+                    let pt = &mesh.panels[t];
+                    let ints = if t == j {
+                        kern.self_integrals(mesh, pj)
+                    } else {
+                        integrals(&kern, mesh, pj, pt.centroid, pt.normal)
+                    };
+                    let half = if t == j { 0.5 } else { 0.0 };
+                    a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
+                    // −(L + α(½ + K')) q_j
+                    op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
+                }
             } else {
-                kern.panel(mesh, pj, pi.centroid, pi.normal)
-            };
-            let half = if i == j { 0.5 } else { 0.0 };
-            row[j] = c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g;
-            // −(L + α(½ + K')) q_j
-            let op = -(ints.g + alpha * (ints.dg_dnx + half));
+                let ints = integrals(&kern, mesh, pj, region.centre, region.normal);
+                a = -ints.dg_dny - alpha * ints.d2g;
+                op = -(ints.g + alpha * ints.dg_dnx);
+            }
+            row[clusters.of_panel[j]] += a;
             for (f, v) in velocities.iter().enumerate() {
                 b[f] += op * (v[j] * iwr);
             }

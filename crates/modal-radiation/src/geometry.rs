@@ -157,8 +157,8 @@ pub(crate) mod tests {
 
     /// Icosphere of radius `r` centred at `c`, `subdiv` subdivisions
     /// (20·4^subdiv panels), corners projected onto the sphere.
-    pub fn icosphere(r: f64, c: [f64; 3], subdiv: usize) -> BoundaryMesh {
-        let (v, t) = crate::shapes::icosphere(subdiv);
+    pub fn icosphere(r: f64, c: [f64; 3], subdiv: u32) -> BoundaryMesh {
+        let (v, t) = modal_mesh::icosphere(subdiv);
         let v = v.iter().map(|p| [0, 1, 2].map(|k| c[k] + r * p[k])).collect();
         BoundaryMesh::new(v, &t).unwrap()
     }

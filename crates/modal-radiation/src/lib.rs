@@ -16,15 +16,18 @@
 //!
 //! - [`BoundaryMesh`]: panels, inside test;
 //! - [`solve`]: surface pressure for several velocity fields at one frequency;
+//! - [`cluster`]: fewer pressure unknowns where the wavelength allows ([`solve_clustered`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
-//! - [`shapes::icosphere`]: the reference sphere surface of the tests.
+//!
+//! The reference sphere surface of the tests is `modal_mesh::icosphere`.
 
 #![warn(missing_docs)]
 
 pub mod bem;
+pub mod cluster;
 mod error;
 pub mod geometry;
 pub mod kernels;
@@ -32,10 +35,10 @@ pub mod mfs;
 pub mod modes;
 pub mod multipole;
 pub mod quadrature;
-pub mod shapes;
 pub mod special;
 
-pub use bem::{solve, Air, Formulation, SurfaceField};
+pub use bem::{solve, solve_clustered, Air, Formulation, SurfaceField};
+pub use cluster::{Adjacency, Clusters};
 pub use error::RadiationError;
 /// Complex f64 (`num_complex::Complex<f64>`), the amplitude type of every field.
 pub use faer::c64;

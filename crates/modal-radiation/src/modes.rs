@@ -18,7 +18,8 @@ use std::time::Instant;
 use faer::c64;
 use modal_bank::ModeBank;
 
-use crate::bem::{solve, Air, Formulation, SurfaceField};
+use crate::bem::{solve_clustered, Air, Formulation, SurfaceField};
+use crate::cluster::{Adjacency, Clusters};
 use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
 use crate::multipole::{fit, Multipole, DEFAULT_TOLERANCE};
@@ -34,10 +35,13 @@ pub struct RadiationOptions {
     pub multipole_tolerance: f64,
     /// Boundary integral equation (Burton–Miller unless studying).
     pub formulation: Formulation,
-    /// Solve a quadratic bank on its corner triangles (a quarter of the
-    /// panels, 1/64 of the LU work) when the wavelength allows it
-    /// ([`COARSE_MAX_KH`]).
+    /// Frequency-adaptive resolution: clustered pressure unknowns
+    /// ([`crate::cluster`]) and, for a quadratic bank, its corner triangles
+    /// when the wavelength allows ([`COARSE_MAX_KH`]). Off: one unknown per
+    /// panel of the four-panel split.
     pub adaptive_resolution: bool,
+    /// `κ`: cluster diameter `κ / max(k, k_s)` (smaller is finer and dearer).
+    pub cluster_kh: f64,
 }
 
 impl Default for RadiationOptions {
@@ -48,6 +52,7 @@ impl Default for RadiationOptions {
             multipole_tolerance: DEFAULT_TOLERANCE,
             formulation: Formulation::BurtonMiller,
             adaptive_resolution: true,
+            cluster_kh: DEFAULT_CLUSTER_KH,
         }
     }
 }
@@ -93,12 +98,17 @@ pub struct Progress {
     pub modes: Vec<usize>,
     /// Its frequency [Hz].
     pub frequency_hz: f64,
-    /// Panels of the solve (fewer at low frequency, see [`COARSE_MAX_KH`]).
+    /// Panels of the solve (geometry and velocity; the corner triangles of
+    /// a quadratic bank at low frequency, see [`COARSE_MAX_KH`]).
     pub panels: usize,
-    /// The panels are too coarse for this frequency: `k·h` above
-    /// [`UNDER_RESOLVED_KH`] (even the finest panels), or the fine panels
-    /// exceed [`MAX_DENSE_PANELS`] and the coarse ones are above
-    /// it. Expect larger errors; mesh finer for such modes.
+    /// Pressure unknowns (clusters of panels, see [`crate::cluster`]).
+    pub unknowns: usize,
+    /// Effective wavenumber `max(k, k_s)` that sized the clusters [1/m].
+    pub k_eff: f64,
+    /// The pressure unknowns are too coarse for this frequency: `k·d` above
+    /// [`UNDER_RESOLVED_KH`] for the cluster diameter `d` and the panels, or
+    /// the clusters had to grow to fit [`MAX_DENSE_PANELS`]. Expect larger
+    /// errors; mesh finer for such modes.
     pub under_resolved: bool,
     /// Seconds spent in the solve (assembly + LU).
     pub solve_s: f64,
@@ -110,11 +120,12 @@ impl std::fmt::Display for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "radiation {}/{}: mode(s) {:?} at {:.1} Hz on {} panels{}, solve {:.2} s, fit {:.2} s",
+            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s, fit {:.2} s",
             self.groups_done,
             self.groups,
             self.modes,
             self.frequency_hz,
+            self.unknowns,
             self.panels,
             if self.under_resolved { " (under-resolved: expect larger errors)" } else { "" },
             self.solve_s,
@@ -293,93 +304,148 @@ pub fn radiate_modes(
     radiate_modes_on(bank, &mesh, modes, opts, progress)
 }
 
-/// Largest `k·h` (wavenumber times the longest panel edge) at which a
-/// quadratic bank is solved on its corner triangles instead of the four
-/// flat panels per triangle: ≥ 12 panels per wavelength. Measured on the
-/// FEM sphere bank (tests/radiation_cli.rs) within the 0.5 dB acceptance.
+/// Largest `k·h` (wavenumber times the longest corner-triangle edge) at which a quadratic bank's velocity and geometry are taken on its
+/// corner triangles (velocity: the exact mean of the quadratic field) instead
+/// of the four flat panels per triangle: ≥ 12 panels per wavelength.
+/// Measured on the FEM sphere bank (tests/radiation_cli.rs) within the
+/// 0.5 dB acceptance.
 pub const COARSE_MAX_KH: f64 = 0.5;
 
-/// `k·h` above which even the finest panels are flagged under-resolved
-/// (fewer than ~6 panels per wavelength).
+/// `k·h` above which the pressure unknowns are flagged under-resolved
+/// (fewer than ~6 per wavelength).
 pub const UNDER_RESOLVED_KH: f64 = 1.0;
 
-/// Largest dense system solved (16 B × N² of memory: 6 000 panels ≈ 0.58 GB).
-/// A quadratic bank whose fine panels exceed it is solved on its corner
-/// triangles at every frequency (flagged in [`Progress::under_resolved`]).
+/// Default `κ`: pressure clusters of diameter `κ / max(k, k_s)`
+/// ([`crate::cluster`]).
+pub const DEFAULT_CLUSTER_KH: f64 = 0.5;
+
+/// Largest cluster diameter as a fraction of the body's radius about the
+/// centre of mass (the pressure must still follow the body's shape at low
+/// frequency).
+pub const MAX_CLUSTER_RADIUS_FRACTION: f64 = 0.5;
+
+/// Largest dense system solved (16 B × N² of memory: 6 000 unknowns ≈ 0.58
+/// GB). Above it the clusters are grown until they fit (flagged in
+/// [`Progress::under_resolved`]).
 pub const MAX_DENSE_PANELS: usize = 6000;
 
-/// The panel meshes of a bank: fine (every surface node a panel corner)
-/// and, for quadratic banks, coarse (the corner triangles), with the
-/// normal velocity of a mode on each.
+/// One panel level of a bank: panels, their adjacency, and how to get a
+/// mode's normal velocity on them.
+struct Level {
+    mesh: Arc<BoundaryMesh>,
+    adjacency: Adjacency,
+    /// Longest panel edge [m].
+    h: f64,
+    /// Per panel, the surface nodes whose mean of `φ·n` is its velocity, with
+    /// the normal to use at each.
+    taps: Vec<[(usize, [f64; 3]); 3]>,
+}
+
+impl Level {
+    fn new(mesh: BoundaryMesh, taps: Vec<[(usize, [f64; 3]); 3]>) -> Level {
+        Level {
+            h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
+            adjacency: Adjacency::new(&mesh),
+            mesh: Arc::new(mesh),
+            taps,
+        }
+    }
+
+    fn velocity(&self, bank: &ModeBank, mode: usize) -> Result<Vec<c64>, RadiationError> {
+        if mode >= bank.mode_count() {
+            return Err(RadiationError::NoSuchMode { mode, count: bank.mode_count() });
+        }
+        Ok(self
+            .taps
+            .iter()
+            .map(|taps| {
+                let v: f64 = taps
+                    .iter()
+                    .map(|&(c, n)| {
+                        let s = bank.shape_at(mode, c);
+                        dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
+                    })
+                    .sum();
+                c64::new(v / 3.0, 0.0)
+            })
+            .collect())
+    }
+}
+
+/// The panel levels of a bank: fine (every surface node a panel corner)
+/// and, for quadratic banks, coarse (the corner triangles, velocity from
+/// the three mid-edge nodes: the exact mean of a quadratic field over the
+/// triangle, since the corner shape functions integrate to zero).
 struct Panels {
-    fine: Arc<BoundaryMesh>,
-    fine_normals: Vec<[[f64; 3]; 3]>,
-    /// Longest edge of the fine panels [m].
-    fine_h: f64,
-    /// Coarse mesh, its longest edge, and the mid-edge nodes of each panel.
-    coarse: Option<(Arc<BoundaryMesh>, f64, Vec<[usize; 3]>)>,
-    node_normals: Vec<[f64; 3]>,
+    fine: Level,
+    coarse: Option<Level>,
 }
 
 impl Panels {
     fn new(bank: &ModeBank, mesh: &BoundaryMesh, adaptive: bool) -> Result<Panels, RadiationError> {
+        if mesh.vertices.len() != bank.surface_node_count() {
+            return Err(RadiationError::Bank("the panel mesh is not the bank's surface".into()));
+        }
+        let normals = corner_normals(bank, mesh);
+        let taps =
+            mesh.panels.iter().zip(&normals).map(|(p, n)| [0, 1, 2].map(|k| (p.corners[k], n[k]))).collect();
         let coarse = match (&bank.surface.triangle_edge_nodes, adaptive) {
             (Some(edges), true) => {
+                let node = node_normals(bank, mesh);
                 let m = BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?;
-                let h = m.panels.iter().map(|p| p.diameter).fold(0.0, f64::max);
-                Some((Arc::new(m), h, edges.clone()))
+                let taps = m
+                    .panels
+                    .iter()
+                    .zip(edges)
+                    .map(|(p, e)| e.map(|c| (c, smooth_or_panel(node[c], p.normal))))
+                    .collect();
+                Some(Level::new(m, taps))
             }
             _ => None,
         };
-        Ok(Panels {
-            fine_h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
-            fine: Arc::new(mesh.clone()),
-            fine_normals: corner_normals(bank, mesh),
-            coarse,
-            node_normals: node_normals(bank, mesh),
-        })
+        Ok(Panels { fine: Level::new(mesh.clone(), taps), coarse })
     }
+}
 
-    /// The mesh to solve on at wavenumber `k`, and whether it is the coarse one.
-    /// The mesh to solve on at wavenumber `k`, whether it is the coarse
-    /// one, and whether it is too coarse for `k` (see [`Progress::under_resolved`]).
-    fn at(&self, k: f64) -> (&Arc<BoundaryMesh>, bool, bool) {
-        match &self.coarse {
-            Some((m, h, _)) if k * h <= COARSE_MAX_KH => (m, true, false),
-            Some((m, h, _)) if self.fine.len() > MAX_DENSE_PANELS => (m, true, k * h > UNDER_RESOLVED_KH),
-            _ => (&self.fine, false, k * self.fine_h > UNDER_RESOLVED_KH),
-        }
-    }
+/// How one frequency group was solved.
+struct Plan<'a> {
+    level: &'a Level,
+    clusters: Clusters,
+    under_resolved: bool,
+    /// Effective wavenumber max(k, k_s) [1/m].
+    k_eff: f64,
+}
 
-    /// Normal velocity of `mode` on the fine or coarse panels. On a coarse
-    /// panel (a curved 6-node triangle) it is the mean of `φ·n` over the
-    /// three mid-edge nodes: the exact mean of a quadratic field over the
-    /// triangle (the corner shape functions integrate to zero).
-    fn velocity(&self, bank: &ModeBank, mode: usize, coarse: bool) -> Result<Vec<c64>, RadiationError> {
-        match (&self.coarse, coarse) {
-            (Some((m, _, edges)), true) => {
-                if mode >= bank.mode_count() {
-                    return Err(RadiationError::NoSuchMode { mode, count: bank.mode_count() });
-                }
-                Ok(m.panels
-                    .iter()
-                    .zip(edges)
-                    .map(|(p, e)| {
-                        let v: f64 = e
-                            .iter()
-                            .map(|&c| {
-                                let s = bank.shape_at(mode, c);
-                                let n = smooth_or_panel(self.node_normals[c], p.normal);
-                                dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
-                            })
-                            .sum();
-                        c64::new(v / 3.0, 0.0)
-                    })
-                    .collect())
-            }
-            _ => normal_velocity_with(bank, &self.fine, &self.fine_normals, mode),
+fn plan<'a>(
+    panels: &'a Panels,
+    k: f64,
+    ks: f64,
+    radius: f64,
+    opts: &RadiationOptions,
+) -> Result<Plan<'a>, RadiationError> {
+    let k_eff = k.max(ks);
+    let level = match &panels.coarse {
+        Some(c) if k * c.h <= COARSE_MAX_KH => c,
+        _ => &panels.fine,
+    };
+    if !opts.adaptive_resolution {
+        if level.mesh.len() > MAX_DENSE_PANELS {
+            return Err(RadiationError::TooManyPanels { panels: level.mesh.len(), max: MAX_DENSE_PANELS });
         }
+        let clusters = Clusters::identity(level.mesh.len());
+        return Ok(Plan { level, clusters, under_resolved: k * level.h > UNDER_RESOLVED_KH, k_eff });
     }
+    let mut diameter = (opts.cluster_kh / k_eff).min(MAX_CLUSTER_RADIUS_FRACTION * radius);
+    let mut clusters = Clusters::grow(&level.mesh, &level.adjacency, diameter);
+    let mut forced = false;
+    while clusters.len() > MAX_DENSE_PANELS {
+        diameter *= 1.25;
+        forced = true;
+        clusters = Clusters::grow(&level.mesh, &level.adjacency, diameter);
+    }
+    let under_resolved =
+        forced || k * diameter.max(level.h) > UNDER_RESOLVED_KH && k * level.h > UNDER_RESOLVED_KH;
+    Ok(Plan { level, clusters, under_resolved, k_eff })
 }
 
 /// [`radiate_modes`] on a given panel mesh of the bank's surface.
@@ -392,11 +458,14 @@ pub fn radiate_modes_on(
 ) -> Result<Vec<ModeRadiation>, RadiationError> {
     let centre = bank.mass.center_of_mass_m;
     let panels = Panels::new(bank, mesh, opts.adaptive_resolution)?;
+    let radius = mesh.radius_about(centre);
+    let mut surface_k = vec![0.0; bank.mode_count()];
     for &m in modes {
-        let v = panels.velocity(bank, m, false)?;
+        let v = panels.fine.velocity(bank, m)?;
         if v.iter().all(|z| z.norm() == 0.0) {
             return Err(RadiationError::NoSurfaceVelocity { mode: m });
         }
+        surface_k[m] = panels.fine.adjacency.surface_wavenumber(&panels.fine.mesh, &v);
     }
     let groups = frequency_groups(bank, modes, opts.group_tolerance);
     let mut out = Vec::with_capacity(modes.len());
@@ -405,14 +474,12 @@ pub fn radiate_modes_on(
             (bank.frequencies_hz[group[0]], bank.frequencies_hz[*group.last().unwrap_or(&group[0])]);
         let f = (lo * hi).sqrt();
         let k = 2.0 * std::f64::consts::PI * f / opts.air.sound_speed_m_s;
-        let (mesh, coarse, under_resolved) = panels.at(k);
-        if mesh.len() > MAX_DENSE_PANELS {
-            return Err(RadiationError::TooManyPanels { panels: mesh.len(), max: MAX_DENSE_PANELS });
-        }
-        let fields =
-            group.iter().map(|&m| panels.velocity(bank, m, coarse)).collect::<Result<Vec<_>, _>>()?;
+        let ks = group.iter().map(|&m| surface_k[m]).fold(0.0, f64::max);
+        let plan = plan(&panels, k, ks, radius, opts)?;
+        let mesh = &plan.level.mesh;
+        let fields = group.iter().map(|&m| plan.level.velocity(bank, m)).collect::<Result<Vec<_>, _>>()?;
         let t0 = Instant::now();
-        let surfaces = solve(mesh, opts.air, f, &fields, opts.formulation)?;
+        let surfaces = solve_clustered(mesh, &plan.clusters, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
@@ -435,7 +502,9 @@ pub fn radiate_modes_on(
             modes: group.clone(),
             frequency_hz: f,
             panels: mesh.len(),
-            under_resolved,
+            unknowns: plan.clusters.len(),
+            k_eff: plan.k_eff,
+            under_resolved: plan.under_resolved,
             solve_s,
             fit_s,
         });

@@ -55,7 +55,16 @@ fn legendre_and_derivative(n: usize, x: f64) -> (f64, f64) {
     (p1, d)
 }
 
-/// Dunavant's 7-point rule: barycentric coordinates and weights (sum 1).
+/// Strang–Fix 3-point rule at the edge-interior points `(2/3, 1/6, 1/6)`,
+/// exact for polynomials of degree 2, weights summing to 1.
+pub const TRIANGLE_3: [([f64; 3], f64); 3] = [
+    ([2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0], 1.0 / 3.0),
+    ([1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0], 1.0 / 3.0),
+    ([1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0], 1.0 / 3.0),
+];
+
+/// Dunavant's 7-point rule, exact for polynomials of degree 5, weights
+/// summing to 1.
 pub const TRIANGLE_7: [([f64; 3], f64); 7] = {
     const A1: f64 = 0.059_715_871_789_770;
     const B1: f64 = 0.470_142_064_105_115;

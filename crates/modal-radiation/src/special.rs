@@ -1,6 +1,11 @@
-//! Special functions: spherical Hankel functions of the first kind and
-//! orthonormal complex spherical harmonics.
+//! Special functions: spherical Bessel and Hankel functions of the first
+//! kind and orthonormal complex spherical harmonics.
 //!
+//! - `j_l(x)` from `j_0 = sin x / x`, `j_1 = sin x / x² − cos x / x`: the
+//!   upward recurrence `j_{l+1} = (2l+1)/x · j_l − j_{l−1}` where it is
+//!   stable (`l < x`), otherwise Miller's downward recurrence from
+//!   `l_0 = L + √(40 L) + 16 + x` (zero start, rescaled against overflow)
+//!   normalized by `j_0` or `j_1`, whichever is larger.
 //! - `h_l(x) = j_l(x) + i y_l(x)`, from `h_0(x) = −i e^{ix}/x`,
 //!   `h_1(x) = −e^{ix}(x + i)/x²` and the upward recurrence
 //!   `h_{l+1} = (2l+1)/x · h_l − h_{l−1}` (stable for `h_l`, whose modulus
@@ -26,6 +31,57 @@ pub fn spherical_hankel(order: usize, x: f64) -> Vec<c64> {
         h.push(next);
     }
     h
+}
+
+/// `j_l(x)` for `l = 0..=order` (`x ≥ 0`), see the module doc.
+pub fn spherical_bessel_j(order: usize, x: f64) -> Vec<f64> {
+    let mut j = vec![0.0; order + 1];
+    if x == 0.0 {
+        j[0] = 1.0;
+        return j;
+    }
+    let (j0, j1) = if x < 1e-3 {
+        let x2 = x * x;
+        (1.0 - x2 / 6.0 + x2 * x2 / 120.0, x / 3.0 * (1.0 - x2 / 10.0))
+    } else {
+        let (s, c) = x.sin_cos();
+        (s / x, s / (x * x) - c / x)
+    };
+    j[0] = j0;
+    if order == 0 {
+        return j;
+    }
+    j[1] = j1;
+    if (order as f64) < x {
+        for l in 1..order {
+            j[l + 1] = (2 * l + 1) as f64 / x * j[l] - j[l - 1];
+        }
+        return j;
+    }
+    let start = order + (40.0 * order as f64).sqrt() as usize + 16 + x as usize;
+    let (mut above, mut here) = (0.0f64, 1e-300f64);
+    for l in (1..=start).rev() {
+        // here = f_l, above = f_{l+1}; f_{l−1} = (2l+1)/x f_l − f_{l+1}.
+        if l <= order {
+            j[l] = here;
+        }
+        let below = (2 * l + 1) as f64 / x * here - above;
+        above = here;
+        here = below;
+        if here.abs() > 1e250 {
+            here *= 1e-250;
+            above *= 1e-250;
+            for v in j.iter_mut().skip(l) {
+                *v *= 1e-250;
+            }
+        }
+    }
+    j[0] = here;
+    let scale = if j0.abs() >= j1.abs() { j0 / j[0] } else { j1 / j[1] };
+    for v in &mut j {
+        *v *= scale;
+    }
+    j
 }
 
 /// `h_l'(x)` for `l = 0..=order` (`x > 0`).
@@ -107,6 +163,42 @@ mod tests {
             assert!((h[2].im - y2).abs() <= 1e-12 * h[2].norm(), "x={x}");
             let j0 = s / x;
             assert!((h[0].re - j0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn bessel_j_matches_hankel_real_part_and_small_argument_series() {
+        // Where the upward recurrence of h_l is accurate for its real part
+        // (|j_l| not much below |h_l|): l ≤ x.
+        for &x in &[0.5, 3.7, 25.0, 80.0] {
+            let order = 60;
+            let j = spherical_bessel_j(order, x);
+            let h = spherical_hankel(order, x);
+            for l in 0..=order.min(x as usize) {
+                assert!(
+                    (j[l] - h[l].re).abs() <= 1e-10 * h[l].norm(),
+                    "l={l} x={x}: {} vs {}",
+                    j[l],
+                    h[l].re
+                );
+            }
+        }
+        // l ≫ x: j_l(x) ≈ x^l/(2l+1)!! · (1 − x²/(2(2l+3))), the next term O(x⁴).
+        for &x in &[1e-4, 0.01, 0.3] {
+            let j = spherical_bessel_j(40, x);
+            let mut dfact = 1.0f64;
+            for (l, jl) in j.iter().enumerate() {
+                dfact *= (2 * l + 1) as f64;
+                let series = x.powi(l as i32) / dfact * (1.0 - x * x / (2.0 * (2 * l + 3) as f64));
+                let rel = x.powi(4) / ((2 * l + 3) as f64 * (2 * l + 5) as f64);
+                assert!((jl - series).abs() <= (rel + 1e-12) * series.abs(), "l={l} x={x}: {jl} vs {series}");
+            }
+        }
+        // A zero of j_0 (x = π): normalized through j_1.
+        let j = spherical_bessel_j(3, std::f64::consts::PI);
+        let h = spherical_hankel(3, std::f64::consts::PI);
+        for l in 0..=3 {
+            assert!((j[l] - h[l].re).abs() < 1e-12, "l={l}");
         }
     }
 

