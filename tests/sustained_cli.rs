@@ -104,4 +104,6 @@ fn issue_16_bad_surface_values_are_refused_naming_the_key() {
         std::fs::write(dir.path().join("s.toml"), format!("{scene}{line}\n")).unwrap();
         modal(dir.path(), &["render", "s.toml", "-o", "s.wav"]).fails_with(key);
     }
+    std::fs::write(dir.path().join("s.toml"), format!("contact_prediction = 0.5\n{scene}")).unwrap();
+    modal(dir.path(), &["render", "s.toml", "-o", "s.wav"]).fails_with("contact_prediction");
 }

@@ -27,6 +27,11 @@ pub struct Scene {
     /// Physics steps per second [Hz] (`physics_rate`).
     #[serde(rename = "physics_rate", default = "defaults::physics_rate")]
     pub physics_rate_hz: f64,
+    /// Contact prediction distance [m] (`contact_prediction`): rapier builds
+    /// speculative contacts between shapes closer than this (default 0.02,
+    /// rapier's, sized for metre-scale bodies; see `crate::physics`).
+    #[serde(rename = "contact_prediction", default = "defaults::contact_prediction")]
+    pub contact_prediction_m: f64,
     /// Gravity [m/s²] (`gravity`).
     #[serde(rename = "gravity", default = "defaults::gravity")]
     pub gravity_m_s2: [f64; 3],
@@ -413,6 +418,9 @@ mod defaults {
     }
     pub fn physics_rate() -> f64 {
         1000.0
+    }
+    pub fn contact_prediction() -> f64 {
+        0.02
     }
     pub fn gravity() -> [f64; 3] {
         [0.0, -9.81, 0.0]

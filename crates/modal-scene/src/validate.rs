@@ -40,6 +40,12 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
             format!("must lie in 30..=20000 Hz, got {}", scene.physics_rate_hz),
         ));
     }
+    if !(1e-4..=0.1).contains(&scene.contact_prediction_m) {
+        return Err(SceneError::invalid(
+            "contact_prediction",
+            format!("must lie in 0.0001..=0.1 m, got {}", scene.contact_prediction_m),
+        ));
+    }
     finite3("gravity", scene.gravity_m_s2)?;
     let l = &scene.listener;
     finite3("listener.position", l.position_m)?;

@@ -164,30 +164,56 @@ fn scalar_f64_recurrence(bencher: Bencher, n: usize) {
     });
 }
 
-/// The force-driven path (`DrivenVoice`, exact first-order hold, f64): one
-/// contact force segment acting over the whole render, a knot per sample.
-#[divan::bench(args = [64, 1024], sample_count = 10)]
-fn driven_force_path(bencher: Bencher, n: usize) {
+/// The force-driven path (`DrivenVoice`, exact first-order hold) with
+/// `kernel`: contact force segments of `segment` knots (chained, at a point
+/// moving along the surface) acting over the whole render, a knot per sample.
+fn driven(bencher: Bencher, n: usize, kernel: modal_synth::Kernel, segment: usize) {
     use modal_synth::{DrivenVoice, ForceSegment, ImpactPoint, SynthModel};
     let samples = samples_for(n, 1 << 22);
     let iterations = 12;
-    let o = SynthOptions { cull_db: None, ..SynthOptions::default() };
+    let o = SynthOptions { cull_db: None, kernel, ..SynthOptions::default() };
     let model = std::sync::Arc::new(SynthModel::new(&bank(n)).expect("bench bank"));
     let mut v = DrivenVoice::from_model(model, o).expect("bench voice");
-    let forces = (0..samples * iterations + 1).map(|k| [0.0, 0.0, (k as f64 * 0.37).sin()]).collect();
-    v.add_segment(ForceSegment {
-        start: 0,
-        oversample: 1,
-        point: ImpactPoint::Position([0.02, 0.02, 0.0]),
-        forces,
-    })
-    .expect("bench segment");
+    let knots = samples * iterations + 1;
+    let mut start = 0;
+    while start + 1 < knots {
+        let end = (start + segment).min(knots - 1);
+        let x = 0.02 + 0.01 * ((start / segment) % 4) as f64;
+        let forces = (start..=end).map(|k| [0.0, 0.0, (k as f64 * 0.37).sin()]).collect();
+        v.add_segment(ForceSegment {
+            start: start as u64,
+            oversample: 1,
+            point: ImpactPoint::Position([x, 0.02, 0.0]),
+            forces,
+        })
+        .expect("bench segment");
+        start = end;
+    }
     let mut out = vec![0.0f32; samples];
     let mut pos = 0u64;
     bencher.counter(ItemsCount::new(n * samples)).bench_local(|| {
-        // Past the segment the modes ring freely: the cost is the same.
+        // Past the segments the modes ring freely: the cost is the same.
         v.render(&mut out, pos);
         pos += samples as u64;
         divan::black_box(&out);
     });
+}
+
+/// f32 tile kernel, one segment acting throughout.
+#[divan::bench(args = [64, 1024], sample_count = 10)]
+fn driven_force_path(bencher: Bencher, n: usize) {
+    driven(bencher, n, modal_synth::Kernel::Auto, usize::MAX / 4);
+}
+
+/// f32 tile kernel, a new 1 ms segment every 48 samples (a physics step at
+/// 1 kHz, as in the sustained-contact scenes).
+#[divan::bench(args = [64, 1024], sample_count = 10)]
+fn driven_force_path_1ms_segments(bencher: Bencher, n: usize) {
+    driven(bencher, n, modal_synth::Kernel::Auto, 48);
+}
+
+/// The f64 reference kernel, one segment acting throughout.
+#[divan::bench(args = [64, 1024], sample_count = 10)]
+fn driven_force_path_f64(bencher: Bencher, n: usize) {
+    driven(bencher, n, modal_synth::Kernel::Reference, usize::MAX / 4);
 }

@@ -34,9 +34,24 @@
 //!
 //! Output: sample `n` holds `y(t_n) = Σ_i Re(W_i z_i(t_n))` with the output
 //! weights `W` of [`crate::ModalVoice`] (velocity or displacement, per-mode
-//! gains). Rendering is f64 per mode; a mode's recurrence costs one complex
-//! multiply, two complex-by-real multiply-adds and the modal force
-//! (`3` multiply-adds per segment) per sample.
+//! gains). A mode's recurrence costs one complex multiply, two
+//! complex-by-real multiply-adds and the modal force (`3` multiply-adds per
+//! segment) per sample.
+//!
+//! Kernels (`SynthOptions::kernel`): `Reference` runs the recurrence in f64,
+//! mode by mode. `Auto` and `Portable` run it in f32 on tiles of
+//! [`crate::force_kernel::FT`] modes ([`crate::force_kernel`]) and keep the
+//! f64 state `z` as an anchor at every multiple of [`crate::BLOCK`] samples:
+//! with `P = e^{sBh}` (f64) and `Q = p̃^B` (the f32-rounded pole `p̃` raised in
+//! f64), the anchor moves by
+//!
+//! `z ← P z + (v − Q z̃)`,
+//!
+//! where `z̃` is `z` rounded to f32 (the f32 run's start) and `v` the f32 state
+//! reached after the block: `v − Q z̃` is the forced part of the block (zero
+//! without force, when the update is the exact `z ← P z`), so the f32 pole's
+//! rounding (≈ 6e-8 rad per sample) never accumulates beyond one block. The
+//! measured error against `Reference` is in the tests (`tests/force.rs`).
 //!
 //! Silence: at every grid point (multiple of [`crate::BLOCK`] samples) with
 //! no force acting, modes whose amplitude `|W z|` is below the absolute floor
@@ -48,8 +63,10 @@ use std::sync::Arc;
 
 use crate::complex::C64;
 use crate::error::SynthError;
+use crate::force_kernel::{self as fk, Lanes, SpanForce, TileConsts, FT};
+use crate::kernel::SimdPath;
 use crate::model::SynthModel;
-use crate::options::{classify_mode, SynthOptions};
+use crate::options::{classify_mode, Kernel, SynthOptions};
 use crate::surface::SurfacePoint;
 use crate::voice::{weight, ImpactPoint, ABSOLUTE_FLOOR, BLOCK};
 
@@ -158,11 +175,53 @@ pub struct DrivenVoice {
     e: Vec<C64>,
     acc: Vec<f64>,
     phi: Vec<f64>,
+    /// The f32 tile kernel's state (`None`: the f64 reference kernel).
+    simd: Option<Box<Tiles>>,
+}
+
+/// The f32 tile kernel's layout, state and scratch (module doc).
+#[derive(Clone, Debug)]
+struct Tiles {
+    path: SimdPath,
+    /// Per mode: `P = p^BLOCK` and `Q = p̃^BLOCK` (module doc).
+    blk_p: Vec<C64>,
+    blk_q: Vec<C64>,
+    /// A force acted since the last anchor.
+    forced: bool,
+    /// The active set or the weights changed since the layout was built.
+    dirty: bool,
+    /// Mode of each lane (`q = t·FT + l`), the active modes when laid out.
+    modes: Vec<usize>,
+    consts: Vec<TileConsts>,
+    /// Running f32 state per tile.
+    zr: Vec<Lanes>,
+    zi: Vec<Lanes>,
+    /// Scratch: per acting segment its coefficients and knots; increments.
+    coef: Vec<Vec<[Lanes; 3]>>,
+    knots: Vec<Vec<[f32; 3]>>,
+    er: Vec<Lanes>,
+    ei: Vec<Lanes>,
+    e64: Vec<C64>,
+    cur: Vec<(f32, f32)>,
+    scratch: fk::Scratch,
+}
+
+/// `x^(2^k)` by `k` squarings.
+fn pow2k(mut x: C64, k: u32) -> C64 {
+    for _ in 0..k {
+        x = x * x;
+    }
+    x
+}
+
+fn round32(z: C64) -> C64 {
+    C64::new(z.re as f32 as f64, z.im as f32 as f64)
 }
 
 impl DrivenVoice {
-    /// A silent driven voice sharing a checked model. `opts.kernel`,
-    /// `budget` and `parallel` do not apply (the kernel is f64, single-threaded).
+    /// A silent driven voice sharing a checked model. `opts.kernel` picks
+    /// the f64 reference or the f32 tile kernel (module doc); `budget` and
+    /// `parallel` do not apply (single-threaded).
     pub fn from_model(model: Arc<SynthModel>, opts: SynthOptions) -> Result<DrivenVoice, SynthError> {
         opts.validate()?;
         let n = model.mode_count();
@@ -190,6 +249,7 @@ impl DrivenVoice {
             e: Vec::new(),
             acc: Vec::new(),
             phi: vec![0.0; n],
+            simd: None,
             model,
             opts,
         };
@@ -201,6 +261,32 @@ impl DrivenVoice {
                 v.pole[i] = s.scale(1.0 / fs).exp();
                 (v.a[i], v.b[i]) = foh_coefficients(s, 1.0 / fs);
             }
+        }
+        let path = match v.opts.kernel {
+            Kernel::Reference => None,
+            Kernel::Portable => Some(SimdPath::Portable),
+            Kernel::Auto => Some(SimdPath::detect()),
+        };
+        if let Some(path) = path {
+            let log2_block = BLOCK.trailing_zeros();
+            v.simd = Some(Box::new(Tiles {
+                path,
+                blk_p: v.pole.iter().map(|&p| pow2k(p, log2_block)).collect(),
+                blk_q: v.pole.iter().map(|&p| pow2k(round32(p), log2_block)).collect(),
+                forced: false,
+                dirty: true,
+                modes: Vec::new(),
+                consts: Vec::new(),
+                zr: Vec::new(),
+                zi: Vec::new(),
+                coef: Vec::new(),
+                knots: Vec::new(),
+                er: Vec::new(),
+                ei: Vec::new(),
+                e64: Vec::new(),
+                cur: vec![(0.0, 0.0); n],
+                scratch: fk::Scratch::default(),
+            }));
         }
         if let Some(g) = v.model.initial_gains(&v.opts.gain)? {
             v.set_gains(&g);
@@ -218,6 +304,9 @@ impl DrivenVoice {
             self.w[i] = weight(self.opts.quantity, self.s[i], gi);
         }
         self.gains_set = true;
+        if let Some(t) = self.simd.as_mut() {
+            t.dirty = true;
+        }
     }
 
     /// Sample rate \[Hz\].
@@ -243,6 +332,13 @@ impl DrivenVoice {
     /// Complex state `z_i` of bank mode `i` now (`q = Im z`, `q̇ = Im(s z)`);
     /// zero for modes not synthesized or out of range.
     pub fn modal_state(&self, i: usize) -> C64 {
+        // Between anchors the f32 kernel's running state is the state.
+        if let Some(t) = self.simd.as_ref().filter(|_| !self.pos.is_multiple_of(BLOCK as u64)) {
+            if let Some(q) = t.modes.iter().position(|&m| m == i) {
+                let (t_, l) = (q / FT, q % FT);
+                return C64::new(t.zr[t_][l] as f64, t.zi[t_][l] as f64);
+            }
+        }
         self.z.get(i).copied().unwrap_or(C64::ZERO)
     }
 
@@ -256,7 +352,7 @@ impl DrivenVoice {
     pub fn mode_energies(&self) -> Vec<f64> {
         (0..self.z.len())
             .map(|i| {
-                let (s, z) = (self.s[i], self.z[i]);
+                let (s, z) = (self.s[i], self.modal_state(i));
                 let q = z.im;
                 let qd = (s * z).im;
                 0.5 * (qd * qd + s.norm2() * q * q)
@@ -340,6 +436,9 @@ impl DrivenVoice {
             }
         }
         self.active.sort_unstable();
+        if let Some(t) = self.simd.as_mut() {
+            t.dirty = true;
+        }
         let live = Live { seq, start: seg.start, m, forces: seg.forces, coef, first, end, fine };
         let at = self.live.partition_point(|l| l.seq < seq);
         self.live.insert(at, live);
@@ -364,6 +463,9 @@ impl DrivenVoice {
             }
         }
         self.active = keep;
+        if let Some(t) = self.simd.as_mut() {
+            t.dirty = true;
+        }
     }
 
     /// ADDS the output for samples `start_sample .. start_sample + out.len()`
@@ -409,12 +511,135 @@ impl DrivenVoice {
                 stop = stop.min(if l.first > pos { l.first } else { l.end });
             }
             let (lo, hi) = ((pos - start_sample) as usize, (stop - start_sample) as usize);
-            self.span(&mut out[lo..hi]);
+            if self.simd.is_some() {
+                self.span_tiles(&mut out[lo..hi]);
+            } else {
+                self.span(&mut out[lo..hi]);
+            }
             let len = stop - pos;
             self.stats.samples_rendered += len;
             self.stats.mode_samples += len * self.active.len() as u64;
             self.pos = stop;
+            if self.simd.is_some() && stop.is_multiple_of(b) {
+                self.anchor();
+            }
         }
+    }
+
+    /// Lays the active modes out in tiles (f32 constants), carrying the
+    /// running state of modes already laid out; new modes (and all, at a
+    /// grid point) start from `z`.
+    fn relayout(&mut self) {
+        let Some(t) = self.simd.as_deref_mut() else { return };
+        for (q, &i) in t.modes.iter().enumerate() {
+            t.cur[i] = (t.zr[q / FT][q % FT], t.zi[q / FT][q % FT]);
+        }
+        let laid: Vec<bool> = {
+            let mut m = vec![false; self.z.len()];
+            t.modes.iter().for_each(|&i| m[i] = true);
+            m
+        };
+        t.modes.clear();
+        t.modes.extend_from_slice(&self.active);
+        let tiles = t.modes.len().div_ceil(FT);
+        t.consts.clear();
+        t.consts.resize(tiles, TileConsts::default());
+        t.zr.clear();
+        t.zr.resize(tiles, [0.0; FT]);
+        t.zi.clear();
+        t.zi.resize(tiles, [0.0; FT]);
+        for (q, &i) in t.modes.iter().enumerate() {
+            let (k, l) = (&mut t.consts[q / FT], q % FT);
+            let (p, a, b, w) = (self.pole[i], self.a[i], self.b[i], self.w[i]);
+            (k.pr[l], k.pi[l]) = (p.re as f32, p.im as f32);
+            (k.ar[l], k.ai[l]) = (a.re as f32, a.im as f32);
+            (k.br[l], k.bi[l]) = (b.re as f32, b.im as f32);
+            (k.wr[l], k.wi[l]) = (w.re as f32, w.im as f32);
+            // At a grid point the running state is the (anchored or culled) `z`.
+            let fresh = !laid[i] || self.pos.is_multiple_of(BLOCK as u64);
+            let (r, im) = if fresh { (self.z[i].re as f32, self.z[i].im as f32) } else { t.cur[i] };
+            (t.zr[q / FT][l], t.zi[q / FT][l]) = (r, im);
+        }
+        t.dirty = false;
+    }
+
+    /// [`Self::span`] with the f32 tile kernel.
+    fn span_tiles(&mut self, out: &mut [f32]) {
+        if self.simd.as_ref().is_some_and(|t| t.dirty) {
+            self.relayout();
+        }
+        let Some(t) = self.simd.as_deref_mut() else { return };
+        let len = out.len();
+        let n0 = self.pos;
+        let tiles = t.consts.len();
+        let covering: Vec<&Live> = self.live.iter().filter(|l| l.first <= n0).collect();
+        let mut acting = 0;
+        for l in covering.iter().filter(|l| l.m == 1) {
+            if t.coef.len() <= acting {
+                t.coef.push(Vec::new());
+                t.knots.push(Vec::new());
+            }
+            let c = &mut t.coef[acting];
+            c.clear();
+            c.resize(tiles, [[0.0; FT]; 3]);
+            for (q, &i) in t.modes.iter().enumerate() {
+                for (comp, x) in l.coef[i].iter().enumerate() {
+                    c[q / FT][comp][q % FT] = *x as f32;
+                }
+            }
+            let off = (n0 - l.start) as usize;
+            let k = &mut t.knots[acting];
+            k.clear();
+            k.extend(l.forces[off..=off + len].iter().map(|f| f.map(|x| x as f32)));
+            acting += 1;
+        }
+        let any_fine = covering.iter().any(|l| l.m > 1);
+        if any_fine {
+            t.er.clear();
+            t.er.resize(tiles * len, [0.0; FT]);
+            t.ei.clear();
+            t.ei.resize(tiles * len, [0.0; FT]);
+            for (q, &i) in t.modes.iter().enumerate() {
+                t.e64.clear();
+                t.e64.resize(len, C64::ZERO);
+                for l in covering.iter().filter(|l| l.m > 1) {
+                    fine_contributions(l, i, n0, &mut t.e64);
+                }
+                for (j, e) in t.e64.iter().enumerate() {
+                    t.er[(q / FT) * len + j][q % FT] = e.re as f32;
+                    t.ei[(q / FT) * len + j][q % FT] = e.im as f32;
+                }
+            }
+        }
+        let forces: Vec<SpanForce<'_>> =
+            (0..acting).map(|k| SpanForce { c: &t.coef[k], f: &t.knots[k] }).collect();
+        let span = fk::Span {
+            consts: &t.consts,
+            zr: &mut t.zr,
+            zi: &mut t.zi,
+            forces: &forces,
+            extra: any_fine.then_some((&t.er[..], &t.ei[..])),
+        };
+        fk::render_span(t.path, span, &mut t.scratch, out);
+        t.forced |= acting > 0 || any_fine;
+    }
+
+    /// Moves the f64 anchor to this grid point (module doc) and restarts
+    /// the f32 run from it.
+    fn anchor(&mut self) {
+        let Some(t) = self.simd.as_deref_mut() else { return };
+        for (q, &i) in t.modes.iter().enumerate() {
+            let (k, l) = (q / FT, q % FT);
+            let z = self.z[i];
+            let mut next = t.blk_p[i] * z;
+            if t.forced {
+                let v = C64::new(t.zr[k][l] as f64, t.zi[k][l] as f64);
+                next += v - t.blk_q[i] * round32(z);
+            }
+            self.z[i] = next;
+            (t.zr[k][l], t.zi[k][l]) = (next.re as f32, next.im as f32);
+        }
+        t.forced = false;
     }
 
     /// Advances the active modes over `out.len()` samples from `self.pos`

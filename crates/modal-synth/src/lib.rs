@@ -23,6 +23,7 @@ mod complex;
 pub mod contact;
 mod error;
 pub mod force;
+pub mod force_kernel;
 pub mod kernel;
 mod model;
 mod offline;
