@@ -42,6 +42,12 @@ pub fn run(shape: MeshShape) -> Result<()> {
                 "surface_volume_m3": r.surface_volume_m3,
                 "max_surface_deviation_m": r.max_surface_deviation_m,
                 "hinged_tets_dropped": r.hinged_tets_dropped,
+                "order": mesh.order(),
+                "curved_edges": r.curved_edges,
+                "min_cell_m": r.min_cell_m,
+                "thin_samples": r.thin_samples,
+                "min_thickness_m": r.min_thickness_m,
+                "max_surface_gap_m": r.max_surface_gap_m,
             });
             if json {
                 print_json(&summary)

@@ -24,7 +24,7 @@
 //! [`crate::BLOCK`] samples from its f64 state and keeps only the forced part
 //! of the f32 run (module doc of [`crate::force`]).
 
-use crate::kernel::SimdPath;
+use crate::kernel::{MulAdd, Plain, SimdPath};
 
 /// Modes per tile (one AVX-512 vector, two AVX2 vectors).
 pub const FT: usize = 16;
@@ -68,27 +68,6 @@ pub struct SpanForce<'a> {
 pub struct Scratch {
     g: Vec<Lanes>,
     lanes: Vec<Lanes>,
-}
-
-trait MulAdd {
-    fn mul_add(a: f32, b: f32, c: f32) -> f32;
-}
-
-struct Plain;
-impl MulAdd for Plain {
-    #[inline(always)]
-    fn mul_add(a: f32, b: f32, c: f32) -> f32 {
-        a * b + c
-    }
-}
-
-#[cfg_attr(not(test), allow(dead_code))]
-struct Fused;
-impl MulAdd for Fused {
-    #[inline(always)]
-    fn mul_add(a: f32, b: f32, c: f32) -> f32 {
-        a.mul_add(b, c)
-    }
 }
 
 /// The modal force knots of tile `t` over the span into `g[..=len]`.
@@ -418,7 +397,7 @@ mod tests {
     fn simd_spans_equal_the_generic_fused_span_bit_for_bit() {
         let path = SimdPath::detect();
         for (segments, extra) in [(0, false), (1, false), (2, false), (1, true), (0, true)] {
-            let want = run_span(segments, extra, &|s, sc, o| span_with::<Fused>(s, sc, o));
+            let want = run_span(segments, extra, &|s, sc, o| span_with::<crate::kernel::Fused>(s, sc, o));
             let got = run_span(segments, extra, &|s, sc, o| render_span(path, s, sc, o));
             assert!(got == want, "{path:?}, {segments} segments, extra {extra}");
             // The portable path rounds differently, within f32 precision.

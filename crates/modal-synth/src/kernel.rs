@@ -54,11 +54,12 @@ impl SimdPath {
     }
 }
 
-trait MulAdd {
+/// `a·b + c`, plain (two roundings) or fused; shared with `force_kernel`.
+pub(crate) trait MulAdd {
     fn mul_add(a: f32, b: f32, c: f32) -> f32;
 }
 
-struct Plain;
+pub(crate) struct Plain;
 impl MulAdd for Plain {
     #[inline(always)]
     fn mul_add(a: f32, b: f32, c: f32) -> f32 {
@@ -67,7 +68,7 @@ impl MulAdd for Plain {
 }
 
 #[cfg_attr(not(test), allow(dead_code))]
-struct Fused;
+pub(crate) struct Fused;
 impl MulAdd for Fused {
     #[inline(always)]
     fn mul_add(a: f32, b: f32, c: f32) -> f32 {

@@ -79,9 +79,15 @@ impl Bvh {
 
     /// Distance from `q` to the nearest triangle (m) (∞ when empty).
     pub fn distance(&self, q: V3) -> f64 {
+        self.closest(q).map_or(f64::INFINITY, |p| norm(sub(q, p)))
+    }
+
+    /// The point of the surface nearest to `q` (`None` when empty).
+    pub fn closest(&self, q: V3) -> Option<V3> {
         let mut best = f64::INFINITY;
+        let mut point = None;
         if self.nodes.is_empty() {
-            return best;
+            return None;
         }
         let mut stack = vec![0usize];
         while let Some(n) = stack.pop() {
@@ -91,13 +97,18 @@ impl Bvh {
             }
             if node.count > 0 {
                 for t in &self.tris[node.first..node.first + node.count] {
-                    best = best.min(norm(sub(q, closest_on_triangle(q, t[0], t[1], t[2]))));
+                    let p = closest_on_triangle(q, t[0], t[1], t[2]);
+                    let d = norm(sub(q, p));
+                    if d < best {
+                        best = d;
+                        point = Some(p);
+                    }
                 }
             } else {
                 stack.extend(node.children);
             }
         }
-        best
+        point
     }
 
     /// Parameters t ∈ [0, 1] (sorted) where segment p→q crosses a triangle.

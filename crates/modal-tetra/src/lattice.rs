@@ -25,24 +25,6 @@ pub struct Lattice {
     pub n: [usize; 3],
 }
 
-/// The 6 black and 8 red neighbour offsets (doubled coordinates).
-pub const NEIGHBOURS: [Coord; 14] = [
-    [2, 0, 0],
-    [-2, 0, 0],
-    [0, 2, 0],
-    [0, -2, 0],
-    [0, 0, 2],
-    [0, 0, -2],
-    [1, 1, 1],
-    [1, 1, -1],
-    [1, -1, 1],
-    [1, -1, -1],
-    [-1, 1, 1],
-    [-1, 1, -1],
-    [-1, -1, 1],
-    [-1, -1, -1],
-];
-
 impl Lattice {
     /// Lattice of cube size `h` covering [lo, hi] with `pad` cubes of margin.
     pub fn covering(lo: V3, hi: V3, h: f64, pad: usize) -> Self {

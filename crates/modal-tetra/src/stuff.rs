@@ -26,7 +26,8 @@ use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::geom::{dihedral_angles_deg, lerp, norm, orient6, sub, V3};
-use crate::lattice::{Lattice, NEIGHBOURS};
+use crate::graded::{is_black, Refiner};
+use crate::lattice::Lattice;
 
 /// Warp threshold on black (long) edges, as a fraction of the edge length.
 pub const ALPHA_LONG: f64 = 0.24969;
@@ -42,6 +43,8 @@ pub(crate) struct Stuffed {
     pub tets: Vec<[usize; 4]>,
     /// Tets of (numerically) zero volume that were dropped.
     pub dropped: usize,
+    /// Shortest background edge (m).
+    pub min_cell: f64,
 }
 
 type Edge = (usize, usize);
@@ -167,27 +170,94 @@ impl Builder<'_> {
     }
 }
 
-/// Stuffs the solid {w ≥ ½} of `bvh` on `lattice`.
-pub(crate) fn stuff(lattice: &Lattice, bvh: &Bvh) -> Stuffed {
+/// The background mesh to stuff: vertices with their side, tets, edges.
+pub(crate) struct Background {
+    /// Vertex positions (m): the lattice points first, in lattice order.
+    pub pos: Vec<V3>,
+    /// Inside (+1) / outside (−1) of every vertex.
+    pub sign: Vec<i8>,
+    /// Tets (vertex indices, any orientation).
+    pub tets: Vec<[usize; 4]>,
+    /// Unique edges (a < b) and whether each is black (axis-aligned: the
+    /// long edges of BCC tets, warped with [`ALPHA_LONG`]).
+    pub edges: Vec<(usize, usize, bool)>,
+    /// Shortest edge (m), for the zero-volume tolerance.
+    pub h_min: f64,
+}
+
+/// The background mesh on `lattice`: its tets (minus those far outside the
+/// solid), refined by longest-edge bisection (module `graded`) wherever a
+/// tet's longest edge exceeds `size_at` at its centroid or a corner, when
+/// a sizing is given. `Err(live tets)` when refinement exceeds `limit` tets.
+pub(crate) fn background(
+    lattice: &Lattice,
+    bvh: &Bvh,
+    size_at: Option<&(dyn Fn(V3) -> f64 + Sync)>,
+    limit: usize,
+) -> Result<Background, usize> {
     let count = lattice.point_count();
-    let mut pos: Vec<V3> = (0..count).map(|i| lattice.position(lattice.coord(i))).collect();
-    let mut sign = signs(lattice, bvh, &pos);
-    let neighbours = |v: usize| {
-        let c = lattice.coord(v);
-        NEIGHBOURS.iter().filter_map(move |d| lattice.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]]))
+    let lattice_pos: Vec<V3> = (0..count).map(|i| lattice.position(lattice.coord(i))).collect();
+    let far_sign = signs(lattice, bvh, &lattice_pos);
+    // A tet whose corners all lie in blocks decided to be far outside holds
+    // no surface: it is dropped before any refinement.
+    let mut tets = Vec::new();
+    lattice.for_each_tet(|t| {
+        if !t.iter().all(|&v| far_sign[v] == -2) {
+            tets.push(t);
+        }
+    });
+    let mut sign: Vec<i8> = far_sign.iter().map(|s| s.signum()).collect();
+    let (pos, tets, coords) = match size_at {
+        None => (lattice_pos, tets, None),
+        Some(size_at) => {
+            let mut r = Refiner::new(lattice, tets);
+            // Refine while the longest edge exceeds the wanted size at the
+            // centroid or a corner.
+            r.refine(
+                |r, t| {
+                    let s = r.size(t);
+                    s > size_at(r.centroid(t)) || r.corners(t).iter().any(|&p| s > size_at(p))
+                },
+                limit,
+            )?;
+            let (pos, tets, coords) = r.finish();
+            let extra: Vec<i8> =
+                pos[count..].par_iter().map(|&p| if bvh.winding(p) >= 0.5 { 1 } else { -1 }).collect();
+            sign.extend(extra);
+            (pos, tets, Some(coords))
+        }
     };
-    let crossing: Vec<Edge> = (0..count)
-        .into_par_iter()
-        .flat_map_iter(|v| {
-            let sign = &sign;
-            neighbours(v).filter(move |&w| w > v && sign[v] != sign[w]).map(move |w| (v, w))
+    let mut edges: Vec<(usize, usize)> =
+        tets.iter().flat_map(|t| TET_EDGES.map(|(a, b)| (t[a].min(t[b]), t[a].max(t[b])))).collect();
+    edges.par_sort_unstable();
+    edges.dedup();
+    let edges: Vec<(usize, usize, bool)> = edges
+        .into_iter()
+        .map(|(a, b)| {
+            let black = match &coords {
+                Some(c) => is_black(c[a], c[b]),
+                None => is_black(lattice.coord(a), lattice.coord(b)),
+            };
+            (a, b, black)
         })
         .collect();
-    let mut cuts: HashMap<Edge, V3> =
-        crossing.par_iter().map(|&(v, w)| ((v, w), cut_point(bvh, pos[v], pos[w], sign[v]))).collect();
-    warp(lattice, &mut pos, &mut sign, &mut cuts, &crossing);
+    let h_min = edges.iter().map(|&(a, b, _)| norm(sub(pos[a], pos[b]))).fold(lattice.h, f64::min);
+    Ok(Background { pos, sign, tets, edges, h_min })
+}
 
-    let h = lattice.h;
+const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// Stuffs the solid {w ≥ ½} of `bvh` on the background mesh.
+pub(crate) fn stuff(bg: Background, bvh: &Bvh) -> Stuffed {
+    let Background { mut pos, mut sign, tets, edges, h_min } = bg;
+    let count = pos.len();
+    let crossing: Vec<(usize, usize, bool)> =
+        edges.iter().filter(|&&(v, w, _)| sign[v] != sign[w]).copied().collect();
+    let mut cuts: HashMap<Edge, V3> =
+        crossing.par_iter().map(|&(v, w, _)| ((v, w), cut_point(bvh, pos[v], pos[w], sign[v]))).collect();
+    warp(&mut pos, &mut sign, &mut cuts, &crossing, &tets);
+
+    let h = h_min;
     let mut b = Builder {
         pos: &pos,
         cuts: &cuts,
@@ -198,10 +268,10 @@ pub(crate) fn stuff(lattice: &Lattice, bvh: &Bvh) -> Stuffed {
         dropped: 0,
         tiny: 1e-12 * h * h * h,
     };
-    lattice.for_each_tet(|t| {
+    for &t in &tets {
         let s = t.map(|i| sign[i]);
         if s.iter().all(|&x| x < 0) {
-            return;
+            continue;
         }
         if s.iter().all(|&x| x == 0) {
             let centroid: V3 = std::array::from_fn(|a| t.iter().map(|&i| pos[i][a]).sum::<f64>() / 4.0);
@@ -212,14 +282,15 @@ pub(crate) fn stuff(lattice: &Lattice, bvh: &Bvh) -> Stuffed {
             if bvh.winding(centroid) >= 0.5 && b.min_angle(whole) >= SLIVER_DEG {
                 b.emit(whole);
             }
-            return;
+            continue;
         }
         b.stencil(t, s);
-    });
-    Stuffed { nodes: b.nodes, tets: b.tets, dropped: b.dropped }
+    }
+    Stuffed { nodes: b.nodes, tets: b.tets, dropped: b.dropped, min_cell: h_min }
 }
 
-/// Inside (+1) / outside (−1) of every lattice point, from the winding number.
+/// Inside (+) / outside (−) of every lattice point, from the winding number:
+/// ±2 for points of blocks decided at once (far from the surface), ±1 else.
 ///
 /// Blocks of cubes far from the surface are classified at once: with the
 /// block's centre c at distance d from every triangle and the block within
@@ -242,7 +313,7 @@ fn signs(lattice: &Lattice, bvh: &Bvh, pos: &[V3]) -> Vec<i8> {
         if extent.iter().all(|&e| e >= 2) && bvh.distance(centre) > BLOCK_MARGIN * radius {
             let w = bvh.winding(centre);
             if (w - 0.5).abs() > BLOCK_CLEARANCE {
-                decided = Some(if w >= 0.5 { 1 } else { -1 });
+                decided = Some(if w >= 0.5 { 2 } else { -2 });
             }
         }
         if decided.is_none() && extent.iter().any(|&e| e >= 2) {
@@ -326,25 +397,47 @@ fn cut_point(bvh: &Bvh, p: V3, q: V3, sp: i8) -> V3 {
     }
 }
 
-/// Snaps lattice points that are too close to a cut point (step 3).
-fn warp(lattice: &Lattice, pos: &mut [V3], sign: &mut [i8], cuts: &mut HashMap<Edge, V3>, crossing: &[Edge]) {
-    let mut ends: Vec<usize> = crossing.iter().flat_map(|&(a, b)| [a, b]).collect();
-    ends.sort_unstable();
-    ends.dedup();
-    let h = lattice.h;
-    for v in ends {
-        let c = lattice.coord(v);
-        let incident: Vec<(usize, bool)> = NEIGHBOURS
-            .iter()
-            .filter_map(|d| {
-                let black = d.iter().any(|&x| x.abs() == 2);
-                lattice.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]]).map(|w| (w, black))
-            })
-            .collect();
+/// Snaps vertices that are too close to a cut point (step 3); `crossing`
+/// are the edges with a cut point (a < b, black flag).
+///
+/// A snap that would turn a background tet around the vertex inside out
+/// (orientation sign change or zero) is not made: on the BCC lattice the
+/// paper's α values never do that, on bisected (graded) tets they can.
+fn warp(
+    pos: &mut [V3],
+    sign: &mut [i8],
+    cuts: &mut HashMap<Edge, V3>,
+    crossing: &[(usize, usize, bool)],
+    tets: &[[usize; 4]],
+) {
+    // Tets around each vertex that may move (CSR).
+    let mut moving = vec![false; pos.len()];
+    for &(a, b, _) in crossing {
+        moving[a] = true;
+        moving[b] = true;
+    }
+    let mut star: Vec<(usize, usize)> = tets
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| t.iter().filter(|&&v| moving[v]).map(move |&v| (v, i)).collect::<Vec<_>>())
+        .collect();
+    star.sort_unstable();
+    let original: Vec<f64> =
+        tets.iter().map(|t| orient6(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]])).collect();
+    // Incident crossing edges per vertex, with their (unwarped) length.
+    let mut incident: Vec<(usize, usize, f64, bool)> = crossing
+        .iter()
+        .flat_map(|&(a, b, black)| {
+            let length = norm(sub(pos[a], pos[b]));
+            [(a, b, length, black), (b, a, length, black)]
+        })
+        .collect();
+    incident.sort_unstable_by_key(|x| (x.0, x.1));
+    for run in incident.chunk_by(|x, y| x.0 == y.0) {
+        let v = run[0].0;
         let mut best: Option<(f64, V3)> = None;
-        for &(w, black) in &incident {
+        for &(_, w, length, black) in run {
             let Some(&cp) = cuts.get(&edge(v, w)) else { continue };
-            let length = if black { h } else { 0.5 * 3f64.sqrt() * h };
             let alpha = if black { ALPHA_LONG } else { ALPHA_SHORT };
             let dist = norm(sub(cp, pos[v]));
             if dist < alpha * length && best.is_none_or(|(d, _)| dist < d) {
@@ -352,9 +445,17 @@ fn warp(lattice: &Lattice, pos: &mut [V3], sign: &mut [i8], cuts: &mut HashMap<E
             }
         }
         if let Some((_, cp)) = best {
+            let first = star.partition_point(|&(w, _)| w < v);
+            let keeps_orientation = star[first..].iter().take_while(|&&(w, _)| w == v).all(|&(_, i)| {
+                let p = tets[i].map(|k| if k == v { cp } else { pos[k] });
+                orient6(p[0], p[1], p[2], p[3]) * original[i] > 0.0
+            });
+            if !keeps_orientation {
+                continue;
+            }
             pos[v] = cp;
             sign[v] = 0;
-            for &(w, _) in &incident {
+            for &(_, w, _, _) in run {
                 cuts.remove(&edge(v, w));
             }
         }

@@ -83,7 +83,16 @@ fn options_control_resolution_and_guard_size() {
     }
     let e = tetrahedralize(&s, &TetOptions { target_tets: Some(0), ..Default::default() }).unwrap_err();
     assert!(matches!(e, TetraError::InvalidOption { .. }));
+    let half = tetrahedralize(&s, &TetOptions { cell: Some(0.02), size_factor: 0.5, ..Default::default() })
+        .unwrap()
+        .1;
+    assert_eq!(half.cell_m, 0.01);
+    assert!(half.tets > 6 * coarse.tets, "{half:?} vs {coarse:?}");
+    let e = tetrahedralize(&s, &TetOptions { size_factor: 0.0, ..Default::default() }).unwrap_err();
+    assert!(matches!(e, TetraError::InvalidOption { name: "size_factor", .. }), "{e}");
     let a = TetOptions::default().cache_key_fields();
+    assert_ne!(a, TetOptions { size_factor: 0.5, ..Default::default() }.cache_key_fields());
+    assert_ne!(a, TetOptions { curved: false, ..Default::default() }.cache_key_fields());
     let b = TetOptions { cell: Some(0.01), ..Default::default() }.cache_key_fields();
     assert_ne!(a, b);
 }
@@ -289,14 +298,21 @@ fn issue_14_corpus_meshes_keep_no_small_hinged_piece_and_pass_the_check() {
 
 #[test]
 fn issue_14_a_thin_solid_falls_back_to_a_finer_cell_or_names_one() {
-    // A 2 mm plate, 10 cm wide: an explicit 8 mm cell finds nothing inside
-    // and names a cell that works; the default cell (thickness-aware) works.
+    // A 2 mm plate, 10 cm wide: an explicit uniform 8 mm cell finds nothing
+    // inside and names a cell that works; the default cell (thickness-aware) works.
     let plate = shapes::cuboid(0.1, 0.1, 0.002);
-    let e = tetrahedralize(&plate, &TetOptions { cell: Some(0.008), ..Default::default() }).unwrap_err();
+    let uniform = TetOptions { cell: Some(0.008), graded: false, ..Default::default() };
+    let e = tetrahedralize(&plate, &uniform).unwrap_err();
     let text = e.to_string();
     assert!(matches!(e, TetraError::NoVolume { .. }), "{text}");
     assert!(text.contains("--cell") && text.contains("works"), "{text}");
     let cell: f64 = text.split("--cell ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
-    let (_, r) = tetrahedralize(&plate, &TetOptions { cell: Some(cell), ..Default::default() }).unwrap();
+    let (_, r) = tetrahedralize(&plate, &TetOptions { cell: Some(cell), ..uniform.clone() }).unwrap();
     assert!(r.tets > 0);
+    // Graded, the same bulk cell refines the plate to its thickness.
+    let (m, r) =
+        tetrahedralize(&plate, &TetOptions { cell: Some(0.008), graded: true, ..Default::default() })
+            .unwrap();
+    assert_good(&m, &r);
+    assert!(rel(r.volume_m3, r.surface_volume_m3).abs() < 0.01, "{r:?}");
 }

@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use modal_mesh::{Cells, TetMesh};
-use modal_tetra::{dihedral_angles_deg, TetReport, TriSurface, DIHEDRAL_BOUNDS_DEG};
+use modal_tetra::{
+    dihedral_angles_deg, TetReport, TriSurface, DIHEDRAL_BOUNDS_DEG, GRADED_DIHEDRAL_BOUNDS_DEG,
+};
 
 /// Checks the output contract of `tetrahedralize` with `modal_mesh::check`
 /// (independent code) and the dihedral-angle bounds on every tet.
@@ -12,10 +14,23 @@ pub fn assert_good(mesh: &TetMesh, report: &TetReport) {
     assert_eq!(r.unused_nodes_dropped, 0, "no unused nodes");
     assert_eq!(checked.nodes.len(), report.nodes);
     assert_eq!(r.tets, report.tets);
-    assert!((r.volume - report.volume_m3).abs() <= 1e-9 * r.volume);
-    let Cells::Tet4(tets) = &mesh.cells else { panic!("expected 4-node tets") };
-    let (lo, hi) = DIHEDRAL_BOUNDS_DEG;
-    for (e, t) in tets.iter().enumerate() {
+    let volume = modal_mesh::mesh_volume(&checked);
+    assert!((volume - report.volume_m3).abs() <= 1e-9 * volume);
+    match &mesh.cells {
+        Cells::Tet4(_) => assert_eq!(report.curved_edges, 0),
+        Cells::Tet10(_) => {
+            // Mid-edge nodes lie on their edge or, on the boundary, on the surface.
+            assert!(report.max_surface_deviation_m.is_finite());
+        }
+    }
+    // Graded meshes (background refined below the lattice cell) have their own bounds.
+    let (lo, hi) = if report.min_cell_m < 0.8 * report.cell_m {
+        GRADED_DIHEDRAL_BOUNDS_DEG
+    } else {
+        DIHEDRAL_BOUNDS_DEG
+    };
+    for e in 0..mesh.cells.len() {
+        let t = mesh.cells.corners(e);
         for a in dihedral_angles_deg(t.map(|i| mesh.nodes[i])) {
             assert!((lo..=hi).contains(&a), "tet {e}: dihedral angle {a:.2}° outside [{lo}, {hi}]");
         }
