@@ -242,7 +242,8 @@ def reference(args):
         p = solver.solve(k, omega * args.air_density, [vn[mi]], args.point)[0]
         print(f"rad_ref: mode {m} at {f:.1f} Hz (k = {k:.2f} 1/m) solved in {time.time() - t1:.1f} s",
               file=sys.stderr)
-        results.append({"index": m, "frequency_hz": f, "pressure_pa": [[z.real, z.imag] for z in p]})
+        results.append({"index": m, "frequency_hz": f, "refine": args.refine,
+                        "pressure_pa": [[z.real, z.imag] for z in p]})
     report = {
         "generator": "tools/rad_ref.py (bempp-cl Galerkin P1/DP1 Burton-Miller)",
         "bank": args.bank,
