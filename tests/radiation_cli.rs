@@ -381,7 +381,8 @@ fn exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones
     };
     let grad_xy = |x: [f64; 3]| [x[1], x[0], 0.0];
     let grad_xyz = |x: [f64; 3]| [x[1] * x[2], x[0] * x[2], x[0] * x[1]];
-    let fields: Vec<(&str, Box<dyn Fn([f64; 3]) -> [f64; 3]>)> = vec![
+    type Field = Box<dyn Fn([f64; 3]) -> [f64; 3]>;
+    let fields: Vec<(&str, Field)> = vec![
         ("T2", Box::new(move |x| cross(x, grad_xy(x)))),
         ("T3", Box::new(move |x| cross(x, grad_xyz(x)))),
         ("S2", Box::new(grad_xy)),
