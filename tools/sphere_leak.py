@@ -15,7 +15,7 @@ at the nodes, at 1600 and 2400 Hz (the fields of the test
 `exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones`).
 
 Packages: those of tools/rad_ref.py (numpy, scipy, safetensors).
-Usage: sphere_leak.py BANK [--radius 0.05] [--analytic]
+Usage: sphere_leak.py BANK [--radius 0.05] [--analytic] [--panels]
 Prints, per mode, its power in dB relative to the quietest spheroidal mode
 (modes with normal-velocity power within 30 dB of the loudest count as
 spheroidal).
@@ -44,6 +44,10 @@ def main():
     ap.add_argument("--radius", type=float, default=0.05)
     ap.add_argument("--analytic", action="store_true")
     ap.add_argument("--degree", type=int, default=8)
+    ap.add_argument("--panels", action="store_true",
+                    help="also the velocity as modal-radiation samples it: constant per flat panel of the "
+                         "four-panel split, the mean of its corners' phi . n (node-averaged or exact radial "
+                         "node normals), projected with flat-panel solid angles")
     args = ap.parse_args()
     a, c, rho = args.radius, 343.0, 1.21
     b = rad_ref.load_bank(args.bank)
@@ -87,6 +91,45 @@ def main():
         modes = [(f"{nm}", f, F) for f in (1600.0, 2400.0) for nm, F in fields]
     else:
         modes = [(str(i), f, b["shapes"][i]) for i, f in enumerate(b["frequencies_hz"])]
+    if args.panels:
+        sub = [(0, 3, 5), (3, 1, 4), (5, 4, 2), (3, 4, 5)]
+        panels = np.concatenate([nodes[:, list(t)] for t in sub])
+        corners = pos[panels]
+        pc = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        area = np.linalg.norm(pc, axis=1) / 2
+        centre = corners.mean(1)
+        rc = np.linalg.norm(centre, axis=1)
+        dirs = centre / rc[:, None]
+        d_omega_p = area * ((pc / (2 * area[:, None])) * dirs).sum(1) / rc**2
+        thp, php = np.arccos(np.clip(dirs[:, 2], -1, 1)), np.arctan2(dirs[:, 1], dirs[:, 0])
+        Yp = [(l, sph_harm_y(l, m, thp, php)) for l in range(args.degree + 1) for m in range(-l, l + 1)]
+        radial = pos / np.linalg.norm(pos, axis=1, keepdims=True)
+        corner = np.zeros(len(pos), bool)
+        corner[b["triangles"].reshape(-1)] = True
+        err = np.degrees(np.arccos(np.clip((n_node * radial).sum(1), -1, 1)))
+        print(f"node-averaged normal vs radial: mean {err[corner].mean():.3f} deg at corner nodes, "
+              f"{err[~corner].mean():.3f} deg at mid-edge nodes")
+
+        def panel_power(vn, f):
+            k = 2 * np.pi * f / c
+            total = 0.0
+            for l, y in Yp:
+                clm = (vn * np.conj(y) * d_omega_p).sum()
+                hp = spherical_jn(l, k * a, derivative=True) + 1j * spherical_yn(l, k * a, derivative=True)
+                total += rho * c * abs(clm) ** 2 / (2 * k * k * abs(hp) ** 2)
+            return total
+        rows_p = []
+        for name, f, shape in modes:
+            rows_p.append((name, f, [panel_power(((shape * nrm).sum(1))[panels].mean(1), f)
+                                     for nrm in (n_node, radial)]))
+        for f0 in sorted({f for _, f, _ in rows_p}) if args.analytic else [None]:
+            group = [r_ for r_ in rows_p if f0 is None or r_[1] == f0]
+            loud = max(r_[2][1] for r_ in group)
+            quiet = [min(r_[2][j] for r_ in group if r_[2][1] > 1e-3 * loud) for j in range(2)]
+            print(f"{'mode':>5} {'Hz':>8}  panels, dB re the quietest spheroidal: node-averaged, radial node normal")
+            for name, f, p in group:
+                print(f"{name:>5} {f:8.1f}  " + "  ".join(f"{10 * np.log10(max(p[j], 1e-300) / quiet[j]):7.1f}"
+                                                      for j in range(2)))
     rows = []
     for name, f, shape in modes:
         u = np.einsum("qp,tqc->tpc", n, shape[nodes]).reshape(-1, 3)
