@@ -299,7 +299,8 @@ fn compare(
 /// (reference solves are cached in `$D/cache`). `MODAL_OLD_BINARY=PATH` runs the old-cell
 /// rows with a `modal` built before the graded mesher (its uniform mesher). Default and
 /// old-cell runs open the band to hold the first 10 modes (`--modes 10 --max-freq 1e6`).
-/// `MODAL_ACCURACY_ASSETS=bracket,soup` limits the run to those assets.
+/// `MODAL_ACCURACY_ASSETS=bracket,soup` limits the run to those assets;
+/// `MODAL_DEFAULT_BINARY=PATH` runs the default rows with another `modal` build.
 /// Prints the BENCHMARKS.md rows and writes `references.json` into `$D`.
 #[test]
 #[ignore = "minutes: reference solves up to 200k DOF; needs the Gmsh meshes (see the doc comment)"]
@@ -309,6 +310,8 @@ fn real_assets_against_converged_references() {
     let cache = dir.join("cache").display().to_string();
     let current = std::path::PathBuf::from(env!("CARGO_BIN_EXE_modal"));
     let old_exe = std::env::var("MODAL_OLD_BINARY").map(std::path::PathBuf::from).unwrap_or(current.clone());
+    let default_exe =
+        std::env::var("MODAL_DEFAULT_BINARY").map(std::path::PathBuf::from).unwrap_or(current.clone());
     let mut summary = Vec::new();
     let mut failures = Vec::new();
     let only = std::env::var("MODAL_ACCURACY_ASSETS").unwrap_or_default();
@@ -337,7 +340,7 @@ fn real_assets_against_converged_references() {
         let old_flags =
             if old_cell.is_some() { [&old_flags[..], &["--cell", &old_cell_s]].concat() } else { old_flags };
         let runs = [
-            ("default", measure(&current, &dir, &obj, &format!("{name}_default.bank"), &ten)),
+            ("default", measure(&default_exe, &dir, &obj, &format!("{name}_default.bank"), &ten)),
             ("old uniform cell", measure_once(&old_exe, &dir, &obj, &format!("{name}_old.bank"), &old_flags)),
         ];
         for (label, run) in runs {

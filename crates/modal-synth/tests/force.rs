@@ -166,37 +166,9 @@ fn test_segments() -> Vec<ForceSegment> {
 }
 
 #[test]
-fn block_size_does_not_change_a_single_bit() {
-    let b = many_modes(40);
-    let total = 6000;
-    let render = |chunk: usize| {
-        let mut v = driven(&b, OutputQuantity::Velocity);
-        for s in test_segments() {
-            v.add_segment(s).unwrap();
-        }
-        let mut out = vec![0.0f32; total];
-        let mut at = 0;
-        while at < total {
-            let len = chunk.min(total - at);
-            v.render(&mut out[at..at + len], at as u64);
-            at += len;
-        }
-        out
-    };
-    let whole = render(total);
-    assert!(peak(&whole) > 0.0);
-    for chunk in [1, 7, 100, 256, 1000] {
-        assert!(render(chunk) == whole, "chunk {chunk} differs");
-    }
-}
-
-#[test]
 fn energy_never_grows_without_force() {
     let b = many_modes(40);
-    let mut v = driven(&b, OutputQuantity::Velocity);
-    for s in test_segments() {
-        v.add_segment(s).unwrap();
-    }
+    let mut v = with_test_segments(&b, Kernel::Reference);
     let mut one = [0.0f32; 1];
     let mut before = f64::INFINITY;
     let mut forced_end = 0;
@@ -244,12 +216,18 @@ fn driven_on(b: &modal_bank::ModeBank, kernel: Kernel) -> DrivenVoice {
     DrivenVoice::from_model(model, o).unwrap()
 }
 
-/// Renders `total` samples of [`test_segments`] in calls of `chunk`.
-fn render_segments(b: &modal_bank::ModeBank, kernel: Kernel, total: usize, chunk: usize) -> Vec<f32> {
+/// A driven voice on `b` with the given kernel, holding every [`test_segments`].
+fn with_test_segments(b: &modal_bank::ModeBank, kernel: Kernel) -> DrivenVoice {
     let mut v = driven_on(b, kernel);
     for s in test_segments() {
         v.add_segment(s).unwrap();
     }
+    v
+}
+
+/// Renders `total` samples of [`test_segments`] in calls of `chunk`.
+fn render_segments(b: &modal_bank::ModeBank, kernel: Kernel, total: usize, chunk: usize) -> Vec<f32> {
+    let mut v = with_test_segments(b, kernel);
     let mut out = vec![0.0f32; total];
     let mut at = 0;
     while at < total {
@@ -281,10 +259,11 @@ fn tile_kernels_track_the_f64_reference() {
     }
 }
 
+/// The f64 reference and the f32 tile kernels alike.
 #[test]
-fn tile_kernels_do_not_change_a_single_bit_with_the_block_size() {
+fn no_kernel_changes_a_single_bit_with_the_block_size() {
     let b = many_modes(40);
-    for kernel in [Kernel::Auto, Kernel::Portable] {
+    for kernel in [Kernel::Reference, Kernel::Auto, Kernel::Portable] {
         let whole = render_segments(&b, kernel, 6000, 6000);
         assert!(peak(&whole) > 0.0);
         for chunk in [1, 7, 100, 256, 1000] {
@@ -298,10 +277,7 @@ fn tile_kernels_do_not_change_a_single_bit_with_the_block_size() {
 #[test]
 fn tile_kernel_energy_never_grows_without_force() {
     let b = many_modes(40);
-    let mut v = driven_on(&b, Kernel::Auto);
-    for s in test_segments() {
-        v.add_segment(s).unwrap();
-    }
+    let mut v = with_test_segments(&b, Kernel::Auto);
     let mut block = [0.0f32; BLOCK];
     let mut before = f64::INFINITY;
     let mut checked = 0;
