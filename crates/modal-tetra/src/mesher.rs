@@ -89,7 +89,7 @@ impl TetOptions {
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
         format!(
-            "tetra=stuffing-v4;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};size_factor={}",
+            "tetra=stuffing-v5;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};size_factor={}",
             self.cell,
             self.target_tets,
             self.cells_per_diagonal,
@@ -375,7 +375,7 @@ pub fn tetrahedralize(
     let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     let feature_nodes_snapped = if options.preserve_features {
-        let (segments, corners) = features(&repaired.vertices, &repaired.triangles);
+        let (segments, corners) = features(&repaired.vertices, &repaired.triangles, &bvh, h);
         snap(&mut stuffed.nodes, &stuffed.tets, &boundary, &segments, &corners, h)
     } else {
         0
