@@ -37,6 +37,8 @@ struct Node {
 #[derive(Clone, Debug)]
 pub struct Bvh {
     tris: Vec<[V3; 3]>,
+    /// Index (in the input order) of each stored triangle.
+    index: Vec<usize>,
     nodes: Vec<Node>,
 }
 
@@ -50,7 +52,7 @@ impl Bvh {
             build(&tris, &centroids, &mut order, 0, &mut nodes);
         }
         let tris = order.iter().map(|&i| tris[i]).collect();
-        Bvh { tris, nodes }
+        Bvh { tris, index: order, nodes }
     }
 
     /// Generalized winding number at `q` (≈1 inside, ≈0 outside).
@@ -109,6 +111,32 @@ impl Bvh {
             }
         }
         point
+    }
+
+    /// Input indices of the triangles whose bounding boxes meet the box [lo, hi].
+    pub fn in_box(&self, lo: V3, hi: V3) -> Vec<usize> {
+        let mut out = Vec::new();
+        let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0usize] };
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n];
+            if (0..3).any(|c| node.hi[c] < lo[c] || node.lo[c] > hi[c]) {
+                continue;
+            }
+            if node.count > 0 {
+                for k in node.first..node.first + node.count {
+                    let t = &self.tris[k];
+                    if (0..3).all(|c| {
+                        let (a, b) = (t[0][c].min(t[1][c]).min(t[2][c]), t[0][c].max(t[1][c]).max(t[2][c]));
+                        a <= hi[c] && b >= lo[c]
+                    }) {
+                        out.push(self.index[k]);
+                    }
+                }
+            } else {
+                stack.extend(node.children);
+            }
+        }
+        out
     }
 
     /// Parameters t ∈ [0, 1] (sorted) where segment p→q crosses a triangle.

@@ -29,7 +29,9 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
-use crate::geom::{add, cross, dihedral_angles_deg, dot, lerp, norm, orient6, scale, sub, V3};
+use crate::geom::{
+    add, cross, dihedral_angles_deg, dot, lerp, norm, orient6, scale, segment_triangle, sub, V3,
+};
 
 /// Input edges sharper than this (angle between the normals) are features.
 pub const FEATURE_ANGLE_DEG: f64 = 35.0;
@@ -54,11 +56,13 @@ pub(crate) fn features(
     bvh: &Bvh,
     h: f64,
 ) -> (Vec<[V3; 2]>, Vec<V3>) {
-    let normal = |t: &[usize; 3]| {
-        let n = cross(sub(vertices[t[1]], vertices[t[0]]), sub(vertices[t[2]], vertices[t[0]]));
-        let l = norm(n);
-        n.map(|c| c / l)
-    };
+    let normals: Vec<V3> = triangles
+        .iter()
+        .map(|t| {
+            unit(cross(sub(vertices[t[1]], vertices[t[0]]), sub(vertices[t[2]], vertices[t[0]])))
+                .unwrap_or([0.0; 3])
+        })
+        .collect();
     let mut edges: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * triangles.len());
     for (i, t) in triangles.iter().enumerate() {
         for k in 0..3 {
@@ -68,8 +72,8 @@ pub(crate) fn features(
     }
     edges.sort_unstable();
     let cos_limit = FEATURE_ANGLE_DEG.to_radians().cos();
-    // (a, b, mean normal) of every feature edge; per vertex the sum of the
-    // mean normals of its feature edges and their count.
+    // (a, b, mean normal) of every sharp input edge; per vertex the sum of the
+    // mean normals of its sharp edges and their count.
     let mut sharp: Vec<(usize, usize, V3)> = Vec::new();
     let mut at_vertex: HashMap<usize, (usize, V3)> = HashMap::new();
     for pair in edges.windows(2) {
@@ -77,7 +81,7 @@ pub(crate) fn features(
         if (x.0, x.1) != (y.0, y.1) {
             continue;
         }
-        let (n1, n2) = (normal(&triangles[x.2]), normal(&triangles[y.2]));
+        let (n1, n2) = (normals[x.2], normals[y.2]);
         if dot(n1, n2) < cos_limit {
             let mean = unit(add(n1, n2)).unwrap_or(n1);
             sharp.push((x.0, x.1, mean));
@@ -88,14 +92,22 @@ pub(crate) fn features(
             }
         }
     }
+    let mut lines: Vec<([V3; 2], V3)> =
+        sharp.iter().map(|&(a, b, n)| ([vertices[a], vertices[b]], n)).collect();
+    lines.extend(intersection_lines(vertices, triangles, &normals, bvh, cos_limit));
+    let mut candidates: Vec<(V3, Option<V3>)> = at_vertex
+        .into_iter()
+        .filter(|(_, (d, _))| *d >= 3)
+        .map(|(v, (_, n))| (vertices[v], unit(n)))
+        .collect();
+    candidates.extend(edge_crossings(vertices, triangles, &normals, bvh, &sharp));
     let delta = PROBE_FRACTION * h;
     let exposed = |m: V3, n: V3| {
         bvh.winding(add(m, scale(n, delta))) < 0.5 && bvh.winding(sub(m, scale(n, delta))) >= 0.5
     };
-    let segments: Vec<[V3; 2]> = sharp
+    let segments: Vec<[V3; 2]> = lines
         .par_iter()
-        .flat_map_iter(|&(a, b, n)| {
-            let (p, q) = (vertices[a], vertices[b]);
+        .flat_map_iter(|&([p, q], n)| {
             let pieces = ((norm(sub(q, p)) / (PIECE_FRACTION * h)).ceil() as usize).clamp(1, MAX_PIECES);
             (0..pieces).filter_map(move |k| {
                 let (s, t) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
@@ -104,15 +116,91 @@ pub(crate) fn features(
             })
         })
         .collect();
-    let corners = at_vertex
-        .into_iter()
-        .filter(|(_, (d, _))| *d >= 3)
-        .filter_map(|(v, (_, n))| {
-            let c = vertices[v];
-            unit(n).is_none_or(|n| exposed(c, n)).then_some(c)
-        })
+    let mut corners: Vec<V3> = candidates
+        .into_par_iter()
+        .filter_map(|(c, n)| n.is_none_or(|n| exposed(c, n)).then_some(c))
         .collect();
+    // A crossing on a shared triangle edge is found from both triangles.
+    corners.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    corners.dedup_by(|a, b| norm(sub(*a, *b)) <= 1e-9 * h);
     (merge(segments), corners)
+}
+
+/// The points where `a` and `b` cross each other's edges (up to duplicates).
+fn crossing_points(a: [V3; 3], b: [V3; 3]) -> Vec<V3> {
+    let mut out = Vec::new();
+    for (x, y) in [(a, b), (b, a)] {
+        for k in 0..3 {
+            let (p, q) = (x[k], x[(k + 1) % 3]);
+            if let Some(t) = segment_triangle(p, q, y[0], y[1], y[2]) {
+                out.push(lerp(p, q, t));
+            }
+        }
+    }
+    out
+}
+
+/// Where two input triangles that share no vertex cross at more than
+/// [`FEATURE_ANGLE_DEG`] (overlapping parts, self-intersections), the solid
+/// has a crease that is no input edge: the segment of the crossing, with the
+/// mean of the two normals.
+fn intersection_lines(
+    vertices: &[V3],
+    triangles: &[[usize; 3]],
+    normals: &[V3],
+    bvh: &Bvh,
+    cos_limit: f64,
+) -> Vec<([V3; 2], V3)> {
+    (0..triangles.len())
+        .into_par_iter()
+        .flat_map_iter(|a| {
+            let ta = triangles[a];
+            let pa = ta.map(|v| vertices[v]);
+            let lo = std::array::from_fn(|c| pa[0][c].min(pa[1][c]).min(pa[2][c]));
+            let hi = std::array::from_fn(|c| pa[0][c].max(pa[1][c]).max(pa[2][c]));
+            bvh.in_box(lo, hi).into_iter().filter_map(move |b| {
+                let tb = triangles[b];
+                if b <= a || tb.iter().any(|v| ta.contains(v)) || dot(normals[a], normals[b]) >= cos_limit {
+                    return None;
+                }
+                let points = crossing_points(pa, tb.map(|v| vertices[v]));
+                let p = *points.first()?;
+                let q =
+                    points.iter().copied().max_by(|x, y| norm(sub(*x, p)).total_cmp(&norm(sub(*y, p))))?;
+                let n = unit(add(normals[a], normals[b]))?;
+                (norm(sub(q, p)) > 0.0).then_some(([p, q], n))
+            })
+        })
+        .collect()
+}
+
+/// Points where a sharp input edge crosses a triangle that does not hold it
+/// (a feature line of one part entering another): corners of the solid,
+/// with the mean of the edge's and the triangle's normals.
+fn edge_crossings(
+    vertices: &[V3],
+    triangles: &[[usize; 3]],
+    normals: &[V3],
+    bvh: &Bvh,
+    sharp: &[(usize, usize, V3)],
+) -> Vec<(V3, Option<V3>)> {
+    sharp
+        .par_iter()
+        .flat_map_iter(|&(a, b, n)| {
+            let (p, q) = (vertices[a], vertices[b]);
+            let lo = std::array::from_fn(|c| p[c].min(q[c]));
+            let hi = std::array::from_fn(|c| p[c].max(q[c]));
+            bvh.in_box(lo, hi).into_iter().filter_map(move |t| {
+                let tri = triangles[t];
+                if tri.contains(&a) || tri.contains(&b) {
+                    return None;
+                }
+                let x = tri.map(|v| vertices[v]);
+                let s = segment_triangle(p, q, x[0], x[1], x[2])?;
+                (s > 1e-9 && s < 1.0 - 1e-9).then(|| (lerp(p, q, s), unit(add(n, normals[t]))))
+            })
+        })
+        .collect()
 }
 
 /// `v / |v|`, or `None` for a (near-)zero vector.
@@ -265,13 +353,14 @@ mod tests {
     use super::*;
     use crate::shapes::cuboid;
 
-    /// A 4 cm cube with a 2 cm cube pushed halfway into the middle of its top face.
+    /// A 4 cm cube with a 2 cm cube pushed halfway into its top face (off the
+    /// top face's diagonals, so no crossing lies on a triangle edge).
     fn union_of_two_boxes() -> (Vec<V3>, Vec<[usize; 3]>) {
         let big = cuboid(0.04, 0.04, 0.04);
         let small = cuboid(0.02, 0.02, 0.02);
         let mut vertices = big.vertices.clone();
         let offset = vertices.len();
-        vertices.extend(small.vertices.iter().map(|p| [p[0] + 0.01, p[1] + 0.01, p[2] + 0.03]));
+        vertices.extend(small.vertices.iter().map(|p| [p[0] + 0.011, p[1] + 0.007, p[2] + 0.03]));
         let mut triangles = big.triangles.clone();
         triangles.extend(small.triangles.iter().map(|t| t.map(|v| v + offset)));
         (vertices, triangles)
@@ -286,7 +375,7 @@ mod tests {
         // Strictly inside the union: inside the big cube below z = 0.04 and inside the small one.
         let buried = |p: V3| {
             let inside = |lo: V3, hi: V3| (0..3).all(|c| p[c] > lo[c] + 1e-9 && p[c] < hi[c] - 1e-9);
-            inside([0.0; 3], [0.04; 3]) || inside([0.01, 0.01, 0.03], [0.03, 0.03, 0.05])
+            inside([0.0; 3], [0.04; 3]) || inside([0.011, 0.007, 0.03], [0.031, 0.027, 0.05])
         };
         for s in &segments {
             assert!(!buried(lerp(s[0], s[1], 0.5)), "buried feature piece {s:?}");
@@ -294,12 +383,17 @@ mod tests {
         for c in &corners {
             assert!(!buried(*c), "buried corner {c:?}");
         }
-        // Exposed: the big cube's 12 edges (4 · 4 cm on top... all 12 · 4 cm) and
-        // the small cube's upper part: 4 top edges and 4 vertical edges above z = 0.04
-        // (1 cm each): 48 + 8 + 4 = 60 cm; its lower 4 edges and lower half are buried.
+        // Exposed: the big cube's 12 edges (48 cm), the small cube's 4 top edges (8 cm)
+        // and its 4 vertical edges above z = 0.04 (4 cm), and the crease where its sides
+        // cross the big top face (4 · 2 cm, no input edge): 68 cm. Its 4 bottom edges
+        // and the lower halves of its vertical edges are buried.
         let length: f64 = segments.iter().map(|s| norm(sub(s[1], s[0]))).sum();
-        assert!((length - 0.60).abs() < 1.5 * PIECE_FRACTION * h * 4.0, "exposed feature length {length}");
-        // The big cube's 8 corners and the small cube's 4 top corners.
-        assert_eq!(corners.len(), 12, "{corners:?}");
+        // Each of the 4 edges that leave the big cube may lose the one piece that straddles it.
+        assert!(length <= 0.68 + 1e-9 && length > 0.68 - 4.0 * PIECE_FRACTION * h, "feature length {length}");
+        // The big cube's 8 corners, the small cube's 4 top corners, and the 4 points
+        // where its vertical edges cross the big top face.
+        assert_eq!(corners.len(), 16, "{corners:?}");
+        let crossing = |c: &V3| (c[2] - 0.04).abs() < 1e-12 && c[0] > 0.0 && c[0] < 0.04;
+        assert_eq!(corners.iter().filter(|c| crossing(c)).count(), 4, "{corners:?}");
     }
 }

@@ -30,9 +30,12 @@
 //!    with a straight fallback per element ([`MIN_JACOBIAN_RATIO`]).
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
-//! [`TetOptions::target_tets`], else h = min(diagonal / 25, 2V/A / 1.5)
-//! (V enclosed volume, A area: 2V/A is the wall thickness of a thin shell).
-//! A sphere gets ≈ 19.6 k tets; the enclosed volume is met within 0.5 %.
+//! [`TetOptions::target_tets`], else
+//! h = min(max(diagonal / 25, (12 V / 12 000)^⅓), 2V/A / 1.5)
+//! (V enclosed volume, A area: 2V/A is the wall thickness of a thin shell;
+//! the middle term, [`DEFAULT_MAX_TETS`], keeps compact solids from getting
+//! far more tets than their first modes need).
+//! A sphere gets ≈ 12 k tets; the enclosed volume is met within 0.5 %.
 //!
 //! Failure modes are typed ([`TetraError`]), never panics: unreadable or
 //! malformed files, NaN coordinates, out-of-range indices, no triangles, an
@@ -65,7 +68,7 @@ pub use geom::dihedral_angles_deg;
 pub use graded::MAX_LEVELS;
 pub use mesher::{
     tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL, DEFAULT_CELLS_PER_THICKNESS,
-    GAP_WARNING, HINGED_DROP_FRACTION,
+    DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION,
 };
 pub use read::{parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};
