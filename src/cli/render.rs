@@ -125,7 +125,7 @@ impl BankProvider for PipelineProvider<'_> {
             return Ok(table.map(Arc::new));
         }
         match self.solved_radiation(request, bank, &what) {
-            Ok(table) => Ok(Some(table)),
+            Ok(table) => Ok(table),
             Err(e) => {
                 self.warnings.push(format!("{what}: no acoustic transfer ({e}); its level is estimated"));
                 Ok(None)
@@ -155,7 +155,7 @@ impl PipelineProvider<'_> {
         request: &BankRequest,
         bank: &ModeBank,
         what: &str,
-    ) -> Result<Arc<RadiationTable>, ProviderError> {
+    ) -> Result<Option<Arc<RadiationTable>>, ProviderError> {
         let opts = modal_radiation::RadiationOptions::default();
         // Modes the synthesizer can play (below 0.45 fs, audible, not overdamped).
         let playable = modal_synth::MAX_FREQUENCY_FRACTION * 2.0 * request.max_frequency_hz;
@@ -188,12 +188,22 @@ impl PipelineProvider<'_> {
         if let Some(path) = entry.as_ref().filter(|p| p.exists()) {
             match ModeBank::load_with_radiation(path) {
                 Ok((cached, Some(table))) if cached.frequencies_hz == bank.frequencies_hz => {
-                    return Ok(Arc::new(table));
+                    return Ok(Some(Arc::new(table)));
                 }
                 _ => self
                     .warnings
                     .push(format!("{what}: damaged radiation cache entry {}: solving again", path.display())),
             }
+        }
+        if modes.is_empty() {
+            // Nothing to solve: every playable mode is above the cap (or none is playable).
+            if above > 0 {
+                self.spinner.note(&format!(
+                    "acoustic transfer of {what}: its {above} playable mode(s) are above {top:.0} Hz: \
+                     level estimate (--transfer-max-freq)"
+                ));
+            }
+            return Ok(None);
         }
         let mesh = modal_radiation::modes::boundary_mesh(bank)?;
         let started = std::time::Instant::now();
@@ -227,7 +237,7 @@ impl PipelineProvider<'_> {
                 self.warnings.push(format!("{what}: cannot cache the acoustic transfer: {e}"));
             }
         }
-        Ok(Arc::new(table))
+        Ok(Some(Arc::new(table)))
     }
 
     /// The cache key of a mesh asset's bank (`None` for bank files).
