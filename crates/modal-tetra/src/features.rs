@@ -36,13 +36,16 @@ use crate::geom::{
 /// Input edges sharper than this (angle between the normals) are features.
 pub const FEATURE_ANGLE_DEG: f64 = 35.0;
 /// Boundary nodes closer than this fraction of h to a feature are snapped.
-pub const SNAP_FRACTION: f64 = 0.5;
+pub const SNAP_FRACTION: f64 = 0.75;
 /// Dihedral range every tet around a moved node must keep (degrees).
 pub const GUARD_DEG: (f64, f64) = (10.0, 165.0);
 /// Feature edges are tested for exposure in pieces of at most this fraction of h.
 pub const PIECE_FRACTION: f64 = 0.25;
 /// Distance of the exposure probes from the feature, as a fraction of h.
 pub const PROBE_FRACTION: f64 = 0.02;
+/// Fractions of the way to a feature edge tried in turn for a boundary node
+/// (the first that keeps the quality guard is kept).
+pub const PARTIAL_MOVES: [f64; 3] = [1.0, 0.75, 0.5];
 /// At most this many pieces are tested per feature edge (very long edges
 /// relative to h are cut into this many).
 const MAX_PIECES: usize = 64;
@@ -315,7 +318,9 @@ pub(crate) fn snap(
             }
         }
         if let Some((d, q)) = best {
-            if d > 0.0 && try_move(nodes, tets, &around[v], v, q) {
+            // Where the whole move would break the quality guard, part of it
+            // still narrows the chamfer.
+            if d > 0.0 && PARTIAL_MOVES.iter().any(|&s| try_move(nodes, tets, &around[v], v, lerp(p, q, s))) {
                 moved += 1;
             }
         }
