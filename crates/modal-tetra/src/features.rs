@@ -43,9 +43,6 @@ pub const GUARD_DEG: (f64, f64) = (10.0, 165.0);
 pub const PIECE_FRACTION: f64 = 0.25;
 /// Distance of the exposure probes from the feature, as a fraction of h.
 pub const PROBE_FRACTION: f64 = 0.02;
-/// Fractions of the way to a feature edge tried in turn for a boundary node
-/// (the first that keeps the quality guard is kept).
-pub const PARTIAL_MOVES: [f64; 3] = [1.0, 0.75, 0.5];
 /// At most this many pieces are tested per feature edge (very long edges
 /// relative to h are cut into this many).
 const MAX_PIECES: usize = 64;
@@ -297,6 +294,10 @@ pub(crate) fn snap(
             }
         }
     }
+    // Each free boundary node's closest feature point within reach; the
+    // nearest nodes move first, so a farther node cannot take an edge spot
+    // (and spoil the quality around it) before the node that belongs there.
+    let mut wanted: Vec<(f64, usize, V3)> = Vec::new();
     for &v in boundary {
         if locked[v] {
             continue;
@@ -317,12 +318,14 @@ pub(crate) fn snap(
                 }
             }
         }
-        if let Some((d, q)) = best {
-            // Where the whole move would break the quality guard, part of it
-            // still narrows the chamfer.
-            if d > 0.0 && PARTIAL_MOVES.iter().any(|&s| try_move(nodes, tets, &around[v], v, lerp(p, q, s))) {
-                moved += 1;
-            }
+        if let Some((d, q)) = best.filter(|&(d, _)| d > 0.0) {
+            wanted.push((d, v, q));
+        }
+    }
+    wanted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (_, v, q) in wanted {
+        if try_move(nodes, tets, &around[v], v, q) {
+            moved += 1;
         }
     }
     moved
