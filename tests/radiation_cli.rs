@@ -352,3 +352,81 @@ fn coarse_panels_at_low_frequency_agree_with_the_full_resolution() {
         assert!((10.0 * (pa / pb).log10()).abs() < 0.5, "power {pa} vs {pb}");
     }
 }
+
+/// Exactly tangential fields on the FEM sphere's curved surface must stay
+/// silent: the radiation pipeline (smooth-surface normals of the quadratic
+/// surface, panels, Burton–Miller solve, multipole power) must not itself
+/// leak a torsional field into sound. `x × ∇q` is tangential to every sphere
+/// about the origin for any `q`; with `q` a harmonic polynomial of degree l
+/// it is the torsional pattern of degree l, and `∇q` the spheroidal one
+/// (normal velocity `l q / r`). All fields have unit RMS over the surface
+/// nodes. (The FEM's own torsional modes are not exactly tangential: see
+/// the test above; this one isolates the radiation side.) The issue's 60 dB
+/// is not met here yet: see the guard below.
+#[test]
+fn exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones() {
+    // The issue asks for 60 dB. Measured (this test, --nocapture): T2 −46.4 dB
+    // at 1600 Hz, −49.4 dB at 2400 Hz; T3 −91.9, −85.4 dB. Projecting the same
+    // node-normal velocity on spherical harmonics over the curved surface
+    // (exact sphere radiation formula, tools-side check) gives T2 −62.3 and
+    // −64.6 dB: the extra leak of T2 is on the solver side (flat panels,
+    // panel velocity, clusters or the multipole power), not in φ·n. Guarded
+    // at the measured level until that is found.
+    const GUARD_DB: f64 = -43.0;
+    let dir = temp_dir();
+    sphere_bank(dir.path());
+    let mut bank = ModeBank::load(dir.path().join("sphere.bank")).unwrap();
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    };
+    let grad_xy = |x: [f64; 3]| [x[1], x[0], 0.0];
+    let grad_xyz = |x: [f64; 3]| [x[1] * x[2], x[0] * x[2], x[0] * x[1]];
+    type Field = Box<dyn Fn([f64; 3]) -> [f64; 3]>;
+    let fields: Vec<(&str, Field)> = vec![
+        ("T2", Box::new(move |x| cross(x, grad_xy(x)))),
+        ("T3", Box::new(move |x| cross(x, grad_xyz(x)))),
+        ("S2", Box::new(grad_xy)),
+        ("S3", Box::new(grad_xyz)),
+    ];
+    let freqs = [1600.0, 2400.0];
+    let nodes = bank.surface.positions.clone();
+    let mut shapes = Vec::new();
+    let mut names = Vec::new();
+    for &f in &freqs {
+        for (name, field) in &fields {
+            let u: Vec<[f64; 3]> = nodes.iter().map(|&x| field(x)).collect();
+            let rms =
+                (u.iter().map(|v| v.iter().map(|c| c * c).sum::<f64>()).sum::<f64>() / u.len() as f64).sqrt();
+            shapes.extend(u.iter().flat_map(|v| v.map(|c| (c / rms) as f32)));
+            names.push((*name, f));
+        }
+    }
+    let n = names.len();
+    bank.frequencies_hz = names.iter().map(|&(_, f)| f).collect();
+    bank.shapes = shapes;
+    bank.damping_ratios = vec![bank.damping_ratios[0]; n];
+    bank.decay_rates = vec![bank.decay_rates[0]; n];
+    bank.residuals = vec![0.0; n];
+    let modes: Vec<usize> = (0..n).collect();
+    let results = modal_radiation::radiate_modes(
+        &bank,
+        &modes,
+        &modal_radiation::RadiationOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let power = |i: usize| results.iter().find(|r| r.mode == i).unwrap().power_w;
+    let mut levels = Vec::new();
+    for (fi, &f) in freqs.iter().enumerate() {
+        let base = fi * fields.len();
+        let quietest_spheroidal = power(base + 2).min(power(base + 3));
+        for t in 0..2 {
+            let db = 10.0 * (power(base + t) / quietest_spheroidal).log10();
+            eprintln!("{} at {f} Hz: {db:.1} dB re the quietest spheroidal field", names[base + t].0);
+            levels.push((names[base + t].0, f, db));
+        }
+    }
+    for (name, f, db) in levels {
+        assert!(db < GUARD_DB, "{name} at {f} Hz: only {db:.1} dB below the spheroidal fields");
+    }
+}

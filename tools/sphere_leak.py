@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""How much a sphere bank's torsional modes radiate, without a boundary
+solve: the normal velocity v_n = phi . n over the bank's curved (quadratic)
+surface is projected on spherical harmonics, and each degree radiates as on
+an exact sphere of radius a (e^{-i omega t}):
+
+    P = rho0 c sum_lm |c_lm|^2 / (2 k^2 |h_l'(ka)|^2),   v_n = sum_lm c_lm Y_l^m.
+
+Three normals are compared: the quadratic map's own normal at each
+quadrature point, the exact radial normal, and the node-averaged quadratic
+normal (as crates/modal-radiation/src/modes.rs) interpolated quadratically.
+With --analytic, the bank's modes are replaced by exactly tangential fields
+x cross grad q (torsional) and grad q (spheroidal), q = xy, xyz, unit RMS
+at the nodes, at 1600 and 2400 Hz (the fields of the test
+`exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones`).
+
+Packages: those of tools/rad_ref.py (numpy, scipy, safetensors).
+Usage: sphere_leak.py BANK [--radius 0.05] [--analytic]
+Prints, per mode, its power in dB relative to the quietest spheroidal mode
+(modes with normal-velocity power within 30 dB of the loudest count as
+spheroidal).
+"""
+
+import argparse
+import os
+import sys
+
+import numpy as np
+from scipy.special import spherical_jn, spherical_yn, sph_harm_y
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rad_ref  # noqa: E402
+
+# Degree-4 six-point triangle rule (Strang-Fix), weights summing to 1/2.
+GP = np.array([[0.445948490915965, 0.445948490915965], [0.445948490915965, 0.10810301816807],
+               [0.10810301816807, 0.445948490915965], [0.091576213509771, 0.091576213509771],
+               [0.091576213509771, 0.816847572980459], [0.816847572980459, 0.091576213509771]])
+GW = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3) / 2
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("bank")
+    ap.add_argument("--radius", type=float, default=0.05)
+    ap.add_argument("--analytic", action="store_true")
+    ap.add_argument("--degree", type=int, default=8)
+    args = ap.parse_args()
+    a, c, rho = args.radius, 343.0, 1.21
+    b = rad_ref.load_bank(args.bank)
+    pos, nodes = b["positions"], np.concatenate([b["triangles"], b["edges"]], 1)
+    x = pos[nodes]
+    n, dxi, deta = rad_ref.quadratic_shape(GP[:, 0], GP[:, 1])
+    X = np.einsum("qp,tqc->tpc", n, x)
+    cr = np.cross(np.einsum("qp,tqc->tpc", dxi, x), np.einsum("qp,tqc->tpc", deta, x))
+    jac = np.linalg.norm(cr, axis=2)
+    n_quad = (cr / jac[..., None]).reshape(-1, 3)
+    w = (jac * GW[None, :]).reshape(-1)
+    Xf = X.reshape(-1, 3)
+    r = np.linalg.norm(Xf, axis=1)
+    n_rad = Xf / r[:, None]
+    # Node-averaged quadratic normals (sum of d x/d xi cross d x/d eta at the node).
+    at = np.array([(0, 0), (1, 0), (0, 1), (.5, 0), (.5, .5), (0, .5)], float)
+    _, dxn, den = rad_ref.quadratic_shape(at[:, 0], at[:, 1])
+    cn = np.cross(np.einsum("qp,tqc->tpc", dxn, x), np.einsum("qp,tqc->tpc", den, x))
+    n_node = np.zeros_like(pos)
+    np.add.at(n_node, nodes.reshape(-1), cn.reshape(-1, 3))
+    n_node /= np.linalg.norm(n_node, axis=1, keepdims=True)
+    th, ph = np.arccos(np.clip(n_rad[:, 2], -1, 1)), np.arctan2(n_rad[:, 1], n_rad[:, 0])
+    Y = [(l, sph_harm_y(l, m, th, ph)) for l in range(args.degree + 1) for m in range(-l, l + 1)]
+    d_omega = w / r**2
+
+    def power(vn, f):
+        k = 2 * np.pi * f / c
+        total = 0.0
+        for l, y in Y:
+            clm = (vn * np.conj(y) * d_omega).sum()
+            hp = spherical_jn(l, k * a, derivative=True) + 1j * spherical_yn(l, k * a, derivative=True)
+            total += rho * c * abs(clm) ** 2 / (2 * k * k * abs(hp) ** 2)
+        return total
+
+    if args.analytic:
+        P = pos
+        g2 = np.stack([P[:, 1], P[:, 0], 0 * P[:, 0]], 1)
+        g3 = np.stack([P[:, 1] * P[:, 2], P[:, 0] * P[:, 2], P[:, 0] * P[:, 1]], 1)
+        fields = [("T2", np.cross(P, g2)), ("T3", np.cross(P, g3)), ("S2", g2), ("S3", g3)]
+        fields = [(nm, (F / np.sqrt((F**2).sum(1).mean())).astype(np.float32).astype(float)) for nm, F in fields]
+        modes = [(f"{nm}", f, F) for f in (1600.0, 2400.0) for nm, F in fields]
+    else:
+        modes = [(str(i), f, b["shapes"][i]) for i, f in enumerate(b["frequencies_hz"])]
+    rows = []
+    for name, f, shape in modes:
+        u = np.einsum("qp,tqc->tpc", n, shape[nodes]).reshape(-1, 3)
+        v_node = np.einsum("qp,tq->tp", n, (shape * n_node).sum(1)[nodes]).reshape(-1)
+        rows.append((name, f, [power((u * n_quad).sum(1), f), power((u * n_rad).sum(1), f), power(v_node, f)]))
+    for f0 in sorted({f for _, f, _ in rows}) if args.analytic else [None]:
+        group = [r_ for r_ in rows if f0 is None or r_[1] == f0]
+        loud = max(r_[2][1] for r_ in group)
+        spheroidal = [r_ for r_ in group if r_[2][1] > 1e-3 * loud]
+        quiet = [min(r_[2][j] for r_ in spheroidal) for j in range(3)]
+        print(f"{'mode':>5} {'Hz':>8}  dB re the quietest spheroidal: quadratic-map, radial, node-averaged normal")
+        for name, f, p in group:
+            print(f"{name:>5} {f:8.1f}  " + "  ".join(f"{10 * np.log10(p[j] / quiet[j]):7.1f}" for j in range(3)))
+
+
+if __name__ == "__main__":
+    main()
