@@ -29,7 +29,19 @@ position = [0.1, 0.1, 0.0]
 fn identical_assets_are_solved_once_and_both_sound() {
     let dir = temp_dir();
     std::fs::write(dir.path().join("s.toml"), TWO_BLOCKS).unwrap();
-    let args = ["render", "s.toml", "-o", "s.wav", "--events", "e.json", "--spectrogram", "s.png", "--json"];
+    let args = [
+        "render",
+        "s.toml",
+        "-o",
+        "s.wav",
+        "--events",
+        "e.json",
+        "--spectrogram",
+        "s.png",
+        "--json",
+        "--radiation",
+        "estimate",
+    ];
     let first = modal(dir.path(), &args).ok().json();
     assert_eq!(first["banks_requested"], 1);
     assert_eq!(first["banks_solved"], 1);

@@ -10,7 +10,19 @@ use std::path::Path;
 
 fn render(dir: &Path, scene: &str, env: &[(&str, &Path)]) -> (serde_json::Value, Vec<serde_json::Value>) {
     let path = example(scene);
-    let args = ["render", path.to_str().unwrap(), "-o", "out.wav", "--events", "e.json", "--json"];
+    // The level estimate keeps these scenes fast (the default solves each
+    // asset's acoustic transfer: tests/render_radiation_cli.rs covers it).
+    let args = [
+        "render",
+        path.to_str().unwrap(),
+        "-o",
+        "out.wav",
+        "--events",
+        "e.json",
+        "--json",
+        "--radiation",
+        "estimate",
+    ];
     let report = modal_with_env(dir, &args, env).ok().json();
     let events: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("e.json")).unwrap()).unwrap();

@@ -393,11 +393,33 @@ pub struct RenderArgs {
     /// Solver threads (default: one per core); the modes do not depend on the count.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
-    /// Solve each mesh asset's acoustic transfer now when the cache has none
-    /// (boundary elements: minutes per asset; cached afterwards). Without it,
-    /// assets without a stored or cached transfer use the level estimate.
-    #[arg(long)]
+    /// How each mode is heard: `transfer` (default: each mesh asset's
+    /// acoustic transfer, solved once by boundary elements and cached with
+    /// its bank, per ear in the body's rotating frame) or `estimate` (the
+    /// direction-free pulsating-sphere level; nothing solved). Overrides the
+    /// scene's `[listener] radiation`.
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub radiation: Option<RadiationChoice>,
+    /// Highest mode frequency [Hz] whose acoustic transfer is solved when a
+    /// mesh asset has none cached; modes above it keep the level estimate
+    /// (said on stderr). The default, 6 kHz, solves the modes the estimate
+    /// gets most wrong (low `ka`) at a cost of seconds to a minute per
+    /// asset; `--transfer-max-freq 24000` solves every playable mode
+    /// (minutes to tens of minutes for a thin bowl; docs/radiation-render).
+    #[arg(long, value_name = "HZ")]
+    pub transfer_max_freq: Option<f64>,
+    /// Accepted for old scripts: solving the transfer is now the default.
+    #[arg(long, hide = true)]
     pub solve_radiation: bool,
+}
+
+/// `render --radiation`.
+#[derive(Debug, Clone, Copy, ValueEnum, PartialEq, Eq)]
+pub enum RadiationChoice {
+    /// Per-mode acoustic transfer (solved and cached when missing).
+    Transfer,
+    /// The direction-free level estimate.
+    Estimate,
 }
 
 /// Output format of a WAV file.

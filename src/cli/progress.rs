@@ -27,6 +27,12 @@ impl Spinner {
         self.bar.set_message(message.into());
     }
 
+    /// Prints a line on stderr above the spinner (progress that should
+    /// stay visible, also when stderr is not a terminal).
+    pub fn note(&self, line: &str) {
+        self.bar.suspend(|| eprintln!("{line}"));
+    }
+
     /// Removes the spinner from the terminal.
     pub fn finish(self) {
         self.bar.finish_and_clear();

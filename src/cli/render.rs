@@ -13,11 +13,17 @@ use modal_precompute::{MeshSource, Request};
 use modal_scene::{BankProvider, BankRequest, ProvidedBank, ProviderError, Scene};
 use modal_synth::WavFormat;
 
-use super::args::RenderArgs;
+use super::args::{RadiationChoice, RenderArgs};
 use super::interrupt;
 use super::output::{print_json, warn};
 use super::precompute::open_cache;
 use super::progress::Spinner;
+
+/// Default `--transfer-max-freq` [Hz]: modes up to it get their acoustic
+/// transfer solved (once per asset, cached), higher ones keep the level
+/// estimate. Measured (docs/radiation-render/README.md): the demo's three
+/// assets cost about a minute at this cap, every mode tens of minutes.
+pub const DEFAULT_TRANSFER_MAX_HZ: f64 = 6000.0;
 
 /// Where the demo is written when no output is given.
 pub const DEMO_OUTPUT: &str = "audio_out/demo.wav";
@@ -39,8 +45,8 @@ struct PipelineProvider<'a> {
     deferred_failed: Arc<AtomicBool>,
     /// Acoustic transfers solved in this run: (asset, modes, seconds).
     radiation_solved: Vec<(String, usize, f64)>,
-    /// Solve missing acoustic transfers now (`--solve-radiation`).
-    solve_radiation: bool,
+    /// Highest mode frequency whose transfer is solved [Hz] (`--transfer-max-freq`).
+    transfer_max_hz: f64,
 }
 
 impl BankProvider for PipelineProvider<'_> {
@@ -119,7 +125,7 @@ impl BankProvider for PipelineProvider<'_> {
             return Ok(table.map(Arc::new));
         }
         match self.solved_radiation(request, bank, &what) {
-            Ok(table) => Ok(Some(table)),
+            Ok(table) => Ok(table),
             Err(e) => {
                 self.warnings.push(format!("{what}: no acoustic transfer ({e}); its level is estimated"));
                 Ok(None)
@@ -149,16 +155,23 @@ impl PipelineProvider<'_> {
         request: &BankRequest,
         bank: &ModeBank,
         what: &str,
-    ) -> Result<Arc<RadiationTable>, ProviderError> {
+    ) -> Result<Option<Arc<RadiationTable>>, ProviderError> {
         let opts = modal_radiation::RadiationOptions::default();
         // Modes the synthesizer can play (below 0.45 fs, audible, not overdamped).
-        let top = modal_synth::MAX_FREQUENCY_FRACTION * 2.0 * request.max_frequency_hz;
+        let playable = modal_synth::MAX_FREQUENCY_FRACTION * 2.0 * request.max_frequency_hz;
+        let top = playable.min(self.transfer_max_hz);
         let modes: Vec<usize> = (0..bank.mode_count())
             .filter(|&i| {
                 let fd = bank.damped_frequency_hz(i);
                 fd >= modal_synth::MIN_FREQUENCY_HZ && fd < top && bank.damping_ratios[i] < 1.0
             })
             .collect();
+        let above = (0..bank.mode_count())
+            .filter(|&i| {
+                let fd = bank.damped_frequency_hz(i);
+                fd >= top && fd < playable && bank.damping_ratios[i] < 1.0
+            })
+            .count();
         let entry = match (&self.cache, self.bank_key(request)?) {
             (Some(cache), Some(key)) => {
                 let key = CacheKey::new("modal-radiation-v1")
@@ -175,23 +188,46 @@ impl PipelineProvider<'_> {
         if let Some(path) = entry.as_ref().filter(|p| p.exists()) {
             match ModeBank::load_with_radiation(path) {
                 Ok((cached, Some(table))) if cached.frequencies_hz == bank.frequencies_hz => {
-                    return Ok(Arc::new(table));
+                    return Ok(Some(Arc::new(table)));
                 }
                 _ => self
                     .warnings
                     .push(format!("{what}: damaged radiation cache entry {}: solving again", path.display())),
             }
         }
-        if !self.solve_radiation {
-            return Err("none cached: render once with --solve-radiation to solve and cache it".into());
+        if modes.is_empty() {
+            // Nothing to solve: every playable mode is above the cap (or none is playable).
+            if above > 0 {
+                self.spinner.note(&format!(
+                    "acoustic transfer of {what}: its {above} playable mode(s) are above {top:.0} Hz: \
+                     level estimate (--transfer-max-freq)"
+                ));
+            }
+            return Ok(None);
         }
         let mesh = modal_radiation::modes::boundary_mesh(bank)?;
         let started = std::time::Instant::now();
         let spinner = self.spinner;
+        let capped = if above > 0 {
+            format!("; {above} mode(s) above {top:.0} Hz keep the level estimate (--transfer-max-freq)")
+        } else {
+            String::new()
+        };
+        spinner.note(&format!(
+            "acoustic transfer of {what}: solving {} mode(s) on {} panels once (cached afterwards; \
+             --radiation estimate skips it){capped}",
+            modes.len(),
+            mesh.len()
+        ));
         let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &modes, &opts, &mut |p| {
             spinner.set(format!(
-                "acoustic transfer of {what}: {}/{} at {:.0} Hz ({} panels)",
-                p.groups_done, p.groups, p.frequency_hz, p.panels
+                "acoustic transfer of {what}: {}/{} at {:.0} Hz, {} unknowns on {} panels, {:.1} s",
+                p.groups_done,
+                p.groups,
+                p.frequency_hz,
+                p.unknowns,
+                p.panels,
+                p.solve_s + p.fit_s
             ))
         })?;
         let table = modal_radiation::modes::to_table(&results, &opts).ok_or("no audible mode")?;
@@ -201,7 +237,7 @@ impl PipelineProvider<'_> {
                 self.warnings.push(format!("{what}: cannot cache the acoustic transfer: {e}"));
             }
         }
-        Ok(Arc::new(table))
+        Ok(Some(Arc::new(table)))
     }
 
     /// The cache key of a mesh asset's bank (`None` for bank files).
@@ -317,6 +353,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         None => (Scene::demo(), PathBuf::from(DEMO_OUTPUT)),
     };
+    if let Some(f) = args.transfer_max_freq {
+        anyhow::ensure!(f.is_finite() && f > 0.0, "--transfer-max-freq must be a positive frequency [Hz]");
+    }
+    let mut scene = scene;
+    match args.radiation {
+        Some(RadiationChoice::Estimate) => scene.listener.radiation = modal_scene::Radiation::Estimate,
+        Some(RadiationChoice::Transfer) => scene.listener.radiation = modal_scene::Radiation::Transfer,
+        None => {}
+    }
     let out = args.out.clone().unwrap_or(default_out);
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
@@ -332,7 +377,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         defer: true,
         deferred_failed: Arc::new(AtomicBool::new(false)),
         radiation_solved: Vec::new(),
-        solve_radiation: args.solve_radiation,
+        transfer_max_hz: args.transfer_max_freq.unwrap_or(DEFAULT_TRANSFER_MAX_HZ),
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);
@@ -375,6 +420,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
         json["banks_cached"] = cached.into();
         json["banks_solved"] = solved.into();
         json["real_time_factor"] = report.real_time_factor().into();
+        json["radiation_solved"] = radiation_solved
+            .iter()
+            .map(|(what, modes, seconds)| serde_json::json!({"asset": what, "modes": modes, "seconds": seconds}))
+            .collect::<Vec<_>>()
+            .into();
         return print_json(&json);
     }
     print_report(report, &out, cached, solved);

@@ -11,7 +11,8 @@
 //! Method ([`bem`]): exterior Neumann Helmholtz problem, time convention
 //! `e^{−iωt}`, Burton–Miller formulation (no fictitious interior
 //! resonances), constant flat panels with centroid collocation, dense
-//! complex LU (faer, sequential) and rayon row assembly: results are
+//! complex LU (faer, sequential) for small systems and restarted GMRES
+//! ([`gmres`]) for large ones, rayon row assembly: results are
 //! bit-identical for any thread count.
 //!
 //! - [`BoundaryMesh`]: panels, inside test;
@@ -30,6 +31,7 @@ pub mod bem;
 pub mod cluster;
 mod error;
 pub mod geometry;
+pub mod gmres;
 pub mod kernels;
 pub mod mfs;
 pub mod modes;
