@@ -36,7 +36,7 @@ use crate::geom::{
 /// Input edges sharper than this (angle between the normals) are features.
 pub const FEATURE_ANGLE_DEG: f64 = 35.0;
 /// Boundary nodes closer than this fraction of h to a feature are snapped.
-pub const SNAP_FRACTION: f64 = 0.5;
+pub const SNAP_FRACTION: f64 = 0.75;
 /// Dihedral range every tet around a moved node must keep (degrees).
 pub const GUARD_DEG: (f64, f64) = (10.0, 165.0);
 /// Feature edges are tested for exposure in pieces of at most this fraction of h.
@@ -294,6 +294,10 @@ pub(crate) fn snap(
             }
         }
     }
+    // Each free boundary node's closest feature point within reach; the
+    // nearest nodes move first, so a farther node cannot take an edge spot
+    // (and spoil the quality around it) before the node that belongs there.
+    let mut wanted: Vec<(f64, usize, V3)> = Vec::new();
     for &v in boundary {
         if locked[v] {
             continue;
@@ -314,10 +318,14 @@ pub(crate) fn snap(
                 }
             }
         }
-        if let Some((d, q)) = best {
-            if d > 0.0 && try_move(nodes, tets, &around[v], v, q) {
-                moved += 1;
-            }
+        if let Some((d, q)) = best.filter(|&(d, _)| d > 0.0) {
+            wanted.push((d, v, q));
+        }
+    }
+    wanted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (_, v, q) in wanted {
+        if try_move(nodes, tets, &around[v], v, q) {
+            moved += 1;
         }
     }
     moved
