@@ -169,20 +169,28 @@ fn test_segments() -> Vec<ForceSegment> {
 fn energy_never_grows_without_force() {
     let b = many_modes(40);
     let mut v = with_test_segments(&b, Kernel::Reference);
-    let mut one = [0.0f32; 1];
+    // The last force knot is at sample 1799 (and the fine pulse at 2000..2001).
+    let (checked, last) = assert_energy_never_grows(&mut v, 1, 8000, 2001);
+    assert!(checked > 5000 && last > 0.0);
+}
+
+/// Renders `calls` calls of `chunk` samples each; from call `first_free` on
+/// (no force acts any more) the modes' total energy must not grow from one
+/// call to the next. Returns how many calls were checked and the last energy.
+fn assert_energy_never_grows(v: &mut DrivenVoice, chunk: usize, calls: u64, first_free: u64) -> (usize, f64) {
+    let mut out = vec![0.0f32; chunk];
     let mut before = f64::INFINITY;
-    let mut forced_end = 0;
-    for n in 0..8000u64 {
-        v.render(&mut one, n);
+    let mut checked = 0;
+    for k in 0..calls {
+        v.render(&mut out, k * chunk as u64);
         let e: f64 = v.mode_energies().iter().sum();
-        // The last force knot is at sample 1799 (and the fine pulse at 2000..2001).
-        if n >= 2001 {
-            assert!(e <= before * (1.0 + 1e-12), "energy grew at sample {n}: {before} -> {e}");
-            forced_end += 1;
+        if k >= first_free {
+            assert!(e <= before * (1.0 + 1e-12), "energy grew at call {k} (chunk {chunk}): {before} -> {e}");
+            checked += 1;
         }
         before = e;
     }
-    assert!(forced_end > 5000 && before > 0.0);
+    (checked, before)
 }
 
 #[test]
@@ -278,20 +286,9 @@ fn no_kernel_changes_a_single_bit_with_the_block_size() {
 fn tile_kernel_energy_never_grows_without_force() {
     let b = many_modes(40);
     let mut v = with_test_segments(&b, Kernel::Auto);
-    let mut block = [0.0f32; BLOCK];
-    let mut before = f64::INFINITY;
-    let mut checked = 0;
-    for k in 0..40u64 {
-        v.render(&mut block, k * BLOCK as u64);
-        let e: f64 = v.mode_energies().iter().sum();
-        // Forces end at sample 2001 (block 7).
-        if k >= 8 {
-            assert!(e <= before * (1.0 + 1e-12), "energy grew at block {k}: {before} -> {e}");
-            checked += 1;
-        }
-        before = e;
-    }
-    assert!(checked > 30 && before > 0.0);
+    // Forces end at sample 2001 (block 7).
+    let (checked, last) = assert_energy_never_grows(&mut v, BLOCK, 40, 8);
+    assert!(checked > 30 && last > 0.0);
 }
 
 /// The impulse limit of [`vanishing_force_pulse_equals_the_impulse_path`]
