@@ -73,14 +73,20 @@ def main():
     Y = [(l, sph_harm_y(l, m, th, ph)) for l in range(args.degree + 1) for m in range(-l, l + 1)]
     d_omega = w / r**2
 
-    def power(vn, f):
-        k = 2 * np.pi * f / c
-        total = 0.0
-        for l, y in Y:
-            clm = (vn * np.conj(y) * d_omega).sum()
-            hp = spherical_jn(l, k * a, derivative=True) + 1j * spherical_yn(l, k * a, derivative=True)
-            total += rho * c * abs(clm) ** 2 / (2 * k * k * abs(hp) ** 2)
-        return total
+    def multipole_power(harmonics, weights):
+        """Radiated power [W] of a normal-velocity field sampled where the spherical
+        harmonics `harmonics` are, with solid-angle weights `weights`."""
+        def power(vn, f):
+            k = 2 * np.pi * f / c
+            total = 0.0
+            for l, y in harmonics:
+                clm = (vn * np.conj(y) * weights).sum()
+                hp = spherical_jn(l, k * a, derivative=True) + 1j * spherical_yn(l, k * a, derivative=True)
+                total += rho * c * abs(clm) ** 2 / (2 * k * k * abs(hp) ** 2)
+            return total
+        return power
+
+    power = multipole_power(Y, d_omega)
 
     if args.analytic:
         P = pos
@@ -109,15 +115,7 @@ def main():
         err = np.degrees(np.arccos(np.clip((n_node * radial).sum(1), -1, 1)))
         print(f"node-averaged normal vs radial: mean {err[corner].mean():.3f} deg at corner nodes, "
               f"{err[~corner].mean():.3f} deg at mid-edge nodes")
-
-        def panel_power(vn, f):
-            k = 2 * np.pi * f / c
-            total = 0.0
-            for l, y in Yp:
-                clm = (vn * np.conj(y) * d_omega_p).sum()
-                hp = spherical_jn(l, k * a, derivative=True) + 1j * spherical_yn(l, k * a, derivative=True)
-                total += rho * c * abs(clm) ** 2 / (2 * k * k * abs(hp) ** 2)
-            return total
+        panel_power = multipole_power(Yp, d_omega_p)
         rows_p = []
         for name, f, shape in modes:
             rows_p.append((name, f, [panel_power(((shape * nrm).sum(1))[panels].mean(1), f)
