@@ -437,7 +437,8 @@ fn surface_assets_get_the_error_estimate_unless_the_manifest_turns_it_off() {
                 [[assets]]\npath = \"props/estimated.obj\"\n\n\
                 [[assets]]\npath = \"props/plain.obj\"\naccuracy = \"off\"\n";
     std::fs::write(dir.path().join("library.toml"), text).unwrap();
-    modal(dir.path(), &["precompute-batch", "library.toml", "--out", "out", "--cache-dir", "cache"], &[]).ok();
+    modal(dir.path(), &["precompute-batch", "library.toml", "--out", "out", "--cache-dir", "cache"], &[])
+        .ok();
     let estimate = |name: &str| {
         let bank = modal_bank::ModeBank::load(dir.path().join(format!("out/props/{name}.bank"))).unwrap();
         (bank.mode_count(), bank.info.error_estimate_pct)

@@ -86,8 +86,12 @@ impl AccuracyKey {
         match self {
             AccuracyKey::Percent(p) if p.is_finite() && *p > 0.0 => Ok(Accuracy::Target(*p)),
             AccuracyKey::Word(w) if w.eq_ignore_ascii_case("off") => Ok(Accuracy::Off),
-            AccuracyKey::Percent(p) => Err(format!("`accuracy` must be a positive percentage or \"off\", got {p}")),
-            AccuracyKey::Word(w) => Err(format!("`accuracy` must be a positive percentage or \"off\", got {w:?}")),
+            AccuracyKey::Percent(p) => {
+                Err(format!("`accuracy` must be a positive percentage or \"off\", got {p}"))
+            }
+            AccuracyKey::Word(w) => {
+                Err(format!("`accuracy` must be a positive percentage or \"off\", got {w:?}"))
+            }
         }
     }
 }
@@ -329,7 +333,8 @@ impl Manifest {
         request.min_freq_hz = o.min_freq.unwrap_or(request.min_freq_hz);
         request.max_freq_hz = o.max_freq.unwrap_or(request.max_freq_hz);
         request.surface = SurfaceMeshing { cell: o.cell, part: o.part.clone() };
-        request.accuracy = match o.accuracy.unwrap_or(Accuracy::Target(AccuracyTarget::default().target_pct)) {
+        request.accuracy = match o.accuracy.unwrap_or(Accuracy::Target(AccuracyTarget::default().target_pct))
+        {
             Accuracy::Target(target_pct) => Some(AccuracyTarget { target_pct, ..AccuracyTarget::default() }),
             Accuracy::Off => None,
         };

@@ -124,7 +124,15 @@ fn solve_level(
     let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
     let cell_m = assembled.cell_m.or(level_cell).unwrap_or(f64::NAN);
     let seconds = start.elapsed().as_secs_f64();
-    Ok(Level { dofs: bank.info.dofs, bank, memory, size_factor, seconds, cell_m, warnings: assembled.warnings })
+    Ok(Level {
+        dofs: bank.info.dofs,
+        bank,
+        memory,
+        size_factor,
+        seconds,
+        cell_m,
+        warnings: assembled.warnings,
+    })
 }
 
 /// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes.
