@@ -38,6 +38,7 @@ use crate::cluster::Clusters;
 use crate::error::RadiationError;
 use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
 use crate::kernels::{Kernels, PanelIntegrals};
+use crate::near::NearField;
 
 /// Properties of the air.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,6 +168,21 @@ pub fn solve_clustered(
     velocities: &[Vec<c64>],
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
+    let near = NearField::new(mesh);
+    solve_with_near(mesh, &near, clusters, air, frequency_hz, velocities, formulation)
+}
+
+/// [`solve_clustered`] with the mesh's near field computed beforehand
+/// (`NearField::new(mesh)`, reused across frequencies).
+pub fn solve_with_near(
+    mesh: &BoundaryMesh,
+    near: &NearField,
+    clusters: &Clusters,
+    air: Air,
+    frequency_hz: f64,
+    velocities: &[Vec<c64>],
+    formulation: Formulation,
+) -> Result<Vec<SurfaceField>, RadiationError> {
     if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
         return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
     }
@@ -184,7 +200,7 @@ pub fn solve_clustered(
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
-    let (mut at, mut rhs) = assemble(mesh, clusters, k, formulation, velocities, iwr);
+    let (mut at, mut rhs) = assemble(mesh, near, clusters, k, formulation, velocities, iwr);
     let pressures = iterative_solve(&at, clusters.len(), &rhs, nrhs)
         .or_else(|| lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs))
         .ok_or(RadiationError::Singular { frequency_hz })?;
@@ -236,7 +252,10 @@ fn test_regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<TestRegion> {
 /// Panels closer than this many (cluster radius + panel diameter) to a
 /// cluster's centre are tested at every member centroid; farther ones at
 /// the cluster's centre alone (the mean of a smooth kernel over the
-/// cluster, to second order in its size).
+/// cluster, to second order in its size). Also every panel within the
+/// cluster radius plus [`MID_POINT_RATIO`] of its diameters, so that every
+/// pair of the near field ([`crate::near`]) is met at its member point and
+/// the cluster's centre never needs the adaptive rule.
 pub const CLUSTER_NEAR_RATIO: f64 = 1.5;
 
 /// Panels farther than this many diameters from the point (and with
@@ -286,6 +305,7 @@ fn integrals(
 /// sides come back row-major `n × nrhs`.
 fn assemble(
     mesh: &BoundaryMesh,
+    near_field: &NearField,
     clusters: &Clusters,
     k: f64,
     formulation: Formulation,
@@ -306,15 +326,26 @@ fn assemble(
     at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
         let region = &regions[i];
         let single = region.members.len() == 1;
+        // Per member, its near-field row and a cursor into it (panels ascend with j).
+        let rows: Vec<_> = region.members.iter().map(|&(t, _)| near_field.row(t)).collect();
+        let mut cursor = vec![0usize; rows.len()];
         for (j, pj) in mesh.panels.iter().enumerate() {
+            let dist = norm(sub(pj.centroid, region.centre));
             let near = single
-                || norm(sub(pj.centroid, region.centre)) < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter);
+                || dist < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter)
+                || dist < region.radius + MID_POINT_RATIO * pj.diameter;
             let (mut a, mut op) = (zero, zero);
             if near {
-                for &(t, w) in &region.members {
+                for (m, &(t, w)) in region.members.iter().enumerate() {
                     let pt = &mesh.panels[t];
+                    let (panels, statics) = rows[m];
+                    while cursor[m] < panels.len() && (panels[cursor[m]] as usize) < j {
+                        cursor[m] += 1;
+                    }
                     let ints = if t == j {
                         kern.self_integrals(mesh, pj)
+                    } else if cursor[m] < panels.len() && panels[cursor[m]] as usize == j {
+                        kern.near(mesh, pj, pt.centroid, pt.normal, &statics[cursor[m]])
                     } else {
                         integrals(&kern, mesh, pj, pt.centroid, pt.normal)
                     };
@@ -410,8 +441,9 @@ mod tests {
             mesh.panels.iter().map(|p| c64::new(p.normal[0] + 0.3 * p.normal[2], 0.0)).collect();
         let k = 20.0;
         let iwr = c64::new(0.0, k * 343.0 * 1.21);
+        let near = NearField::new(&mesh);
         let (mut at, mut rhs) =
-            assemble(&mesh, &Clusters::identity(n), k, Formulation::BurtonMiller, &[vel], iwr);
+            assemble(&mesh, &near, &Clusters::identity(n), k, Formulation::BurtonMiller, &[vel], iwr);
         let it = iterative_solve(&at, n, &rhs, 1).expect("GMRES converges");
         let lu = lu_solve_transposed(&mut at, n, &mut rhs, 1).unwrap();
         let diff: f64 = (0..n).map(|i| (it[(i, 0)] - lu[(i, 0)]).norm_sqr()).sum::<f64>().sqrt();

@@ -18,6 +18,7 @@
 //! - [`BoundaryMesh`]: panels, inside test;
 //! - [`solve`]: surface pressure for several velocity fields at one frequency;
 //! - [`cluster`]: fewer pressure unknowns where the wavelength allows ([`solve_clustered`]);
+//! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`solve_with_near`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
@@ -36,10 +37,11 @@ pub mod kernels;
 pub mod mfs;
 pub mod modes;
 pub mod multipole;
+pub mod near;
 pub mod quadrature;
 pub mod special;
 
-pub use bem::{solve, solve_clustered, Air, Formulation, SurfaceField};
+pub use bem::{solve, solve_clustered, solve_with_near, Air, Formulation, SurfaceField};
 pub use cluster::{Adjacency, Clusters};
 pub use error::RadiationError;
 /// Complex f64 (`num_complex::Complex<f64>`), the amplitude type of every field.
@@ -47,3 +49,4 @@ pub use faer::c64;
 pub use geometry::{BoundaryMesh, Panel};
 pub use modes::{radiate_modes, ModeRadiation, Progress, RadiationOptions};
 pub use multipole::Multipole;
+pub use near::NearField;

@@ -18,11 +18,12 @@ use std::time::Instant;
 use faer::c64;
 use modal_bank::ModeBank;
 
-use crate::bem::{solve_clustered, Air, Formulation, SurfaceField};
+use crate::bem::{solve_with_near, Air, Formulation, SurfaceField};
 use crate::cluster::{Adjacency, Clusters};
 use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
 use crate::multipole::{fit, Multipole, DEFAULT_TOLERANCE};
+use crate::near::NearField;
 
 /// Options of a bank radiation run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,8 +111,14 @@ pub struct Progress {
     /// the clusters had to grow to fit [`MAX_DENSE_PANELS`]. Expect larger
     /// errors; mesh finer for such modes.
     pub under_resolved: bool,
-    /// Seconds spent in the solve (assembly + LU).
+    /// Seconds spent in the solve (near field when first needed, assembly,
+    /// GMRES or LU).
     pub solve_s: f64,
+    /// Of `solve_s`, seconds spent integrating the static near field of the
+    /// panel level ([`crate::near`]): once per level, 0 when reused.
+    pub near_s: f64,
+    /// Memory held by that near field [bytes].
+    pub near_bytes: usize,
     /// Seconds spent in the multipole fit.
     pub fit_s: f64,
 }
@@ -120,7 +127,7 @@ impl std::fmt::Display for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s, fit {:.2} s",
+            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s{}, fit {:.2} s",
             self.groups_done,
             self.groups,
             self.modes,
@@ -129,6 +136,11 @@ impl std::fmt::Display for Progress {
             self.panels,
             if self.under_resolved { " (under-resolved: expect larger errors)" } else { "" },
             self.solve_s,
+            if self.near_s > 0.0 {
+                format!(" (near field {:.2} s, {:.0} MB)", self.near_s, self.near_bytes as f64 / 1e6)
+            } else {
+                String::new()
+            },
             self.fit_s
         )
     }
@@ -329,11 +341,13 @@ pub const MAX_CLUSTER_RADIUS_FRACTION: f64 = 0.5;
 /// [`Progress::under_resolved`]).
 pub const MAX_DENSE_PANELS: usize = 6000;
 
-/// One panel level of a bank: panels, their adjacency, and how to get a
-/// mode's normal velocity on them.
+/// One panel level of a bank: panels, their adjacency, their near field
+/// (integrated when the level is first solved on), and how to get a mode's
+/// normal velocity on them.
 struct Level {
     mesh: Arc<BoundaryMesh>,
     adjacency: Adjacency,
+    near: std::sync::OnceLock<NearField>,
     /// Longest panel edge [m].
     h: f64,
     /// Per panel, the surface nodes whose mean of `φ·n` is its velocity, with
@@ -346,6 +360,7 @@ impl Level {
         Level {
             h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
             adjacency: Adjacency::new(&mesh),
+            near: std::sync::OnceLock::new(),
             mesh: Arc::new(mesh),
             taps,
         }
@@ -479,7 +494,10 @@ pub fn radiate_modes_on(
         let mesh = &plan.level.mesh;
         let fields = group.iter().map(|&m| plan.level.velocity(bank, m)).collect::<Result<Vec<_>, _>>()?;
         let t0 = Instant::now();
-        let surfaces = solve_clustered(mesh, &plan.clusters, opts.air, f, &fields, opts.formulation)?;
+        let fresh = plan.level.near.get().is_none();
+        let near = plan.level.near.get_or_init(|| NearField::new(mesh));
+        let near_s = if fresh { t0.elapsed().as_secs_f64() } else { 0.0 };
+        let surfaces = solve_with_near(mesh, near, &plan.clusters, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
@@ -506,6 +524,8 @@ pub fn radiate_modes_on(
             k_eff: plan.k_eff,
             under_resolved: plan.under_resolved,
             solve_s,
+            near_s,
+            near_bytes: near.bytes(),
             fit_s,
         });
     }
