@@ -20,6 +20,7 @@
 //! - [`cluster`]: fewer pressure unknowns where the wavelength allows ([`solve_clustered`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
+//! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
 //!
@@ -36,6 +37,7 @@ pub mod kernels;
 pub mod mfs;
 pub mod modes;
 pub mod multipole;
+pub mod normals;
 pub mod quadrature;
 pub mod special;
 
