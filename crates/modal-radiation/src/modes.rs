@@ -169,7 +169,11 @@ const SPLIT_CORNERS: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 
 /// [`boundary_mesh`]; on any other panel mesh over the bank's nodes each
 /// node's first-sector normal is used.
 pub fn corner_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[[f64; 3]; 3]> {
-    let normals = surface_normals(bank);
+    corner_normals_of(bank, mesh, &surface_normals(bank))
+}
+
+/// [`corner_normals`] from the bank's [`surface_normals`] `normals`.
+fn corner_normals_of(bank: &ModeBank, mesh: &BoundaryMesh, normals: &SurfaceNormals) -> Vec<[[f64; 3]; 3]> {
     let s = &bank.surface;
     let (split, per_triangle) = match &s.triangle_edge_nodes {
         Some(_) => (&SPLIT_CORNERS[..], 4),
@@ -365,18 +369,18 @@ impl Panels {
         if mesh.vertices.len() != bank.surface_node_count() {
             return Err(RadiationError::Bank("the panel mesh is not the bank's surface".into()));
         }
-        let normals = corner_normals(bank, mesh);
+        let smooth = surface_normals(bank);
+        let normals = corner_normals_of(bank, mesh, &smooth);
         let taps =
             mesh.panels.iter().zip(&normals).map(|(p, n)| [0, 1, 2].map(|k| (p.corners[k], n[k]))).collect();
         let coarse = match (&bank.surface.triangle_edge_nodes, adaptive) {
             (Some(edges), true) => {
-                let normals = surface_normals(bank);
                 let m = BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?;
                 let taps = m
                     .panels
                     .iter()
                     .zip(edges)
-                    .zip(&normals.per_triangle)
+                    .zip(&smooth.per_triangle)
                     .map(|((p, e), n)| [0, 1, 2].map(|k| (e[k], smooth_or_panel(n[3 + k], p.normal))))
                     .collect();
                 Some(Level::new(m, taps))

@@ -152,7 +152,8 @@ impl Triangles {
 }
 
 /// Reference coordinates `(ξ, η)` of the six nodes of a quadratic triangle.
-const REFERENCE_NODES: [(f64, f64); 6] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
+const REFERENCE_NODES: [(f64, f64); 6] =
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
 
 /// `∂x/∂ξ × ∂x/∂η` of the 6-node triangle (corners 0–2, mid-edge nodes of
 /// edges 01, 12, 20) at `(ξ, η)`: the normal scaled by twice the local area
@@ -184,7 +185,8 @@ struct Sectors {
 
 impl Sectors {
     fn new(surface: &Triangles, cos_crease: f64) -> Sectors {
-        let mut sectors = Sectors { node: Vec::new(), members: Vec::new(), of: vec![[0; 6]; surface.nodes.len()] };
+        let mut sectors =
+            Sectors { node: Vec::new(), members: Vec::new(), of: vec![[0; 6]; surface.nodes.len()] };
         for (p, around) in surface.incident.iter().enumerate() {
             // Union-find over the triangles around p.
             let mut root: Vec<usize> = (0..around.len()).collect();
@@ -198,7 +200,8 @@ impl Sectors {
             for i in 0..around.len() {
                 for j in i + 1..around.len() {
                     let ((ti, ki), (tj, kj)) = (around[i], around[j]);
-                    let shared = surface.corners(ti).iter().filter(|c| surface.corners(tj).contains(c)).count();
+                    let shared =
+                        surface.corners(ti).iter().filter(|c| surface.corners(tj).contains(c)).count();
                     // An edge at p: two shared corners (p a corner and one
                     // more, or the edge whose mid-node p is).
                     let (ni, nj) = (surface.raw[ti][ki], surface.raw[tj][kj]);
@@ -209,19 +212,16 @@ impl Sectors {
                     }
                 }
             }
-            let first = sectors.node.len();
             let mut ids = vec![usize::MAX; around.len()];
-            for i in 0..around.len() {
+            for (i, &(t, k)) in around.iter().enumerate() {
                 let r = find(&mut root, i);
                 if ids[r] == usize::MAX {
                     ids[r] = sectors.node.len();
                     sectors.node.push(p);
                     sectors.members.push(Vec::new());
                 }
-                let s = ids[r];
-                debug_assert!(s >= first);
-                sectors.members[s].push(around[i]);
-                sectors.of[around[i].0][around[i].1] = s;
+                sectors.members[ids[r]].push((t, k));
+                sectors.of[t][k] = ids[r];
             }
         }
         sectors
@@ -231,9 +231,7 @@ impl Sectors {
     fn mean_normal(&self, surface: &Triangles, s: usize) -> [f64; 3] {
         let mut n = [0.0; 3];
         for &(t, k) in &self.members[s] {
-            for q in 0..3 {
-                n[q] += surface.raw[t][k][q];
-            }
+            n = [0, 1, 2].map(|q| n[q] + surface.raw[t][k][q]);
         }
         let len = norm(n);
         n.map(|x| x / len)
@@ -387,10 +385,9 @@ mod tests {
     fn pairs(s: &Surface, n: &SurfaceNormals) -> Vec<(usize, [f64; 3], [f64; 3])> {
         let surf = Triangles::new(&s.positions, &s.triangles, s.triangle_edge_nodes.as_deref());
         let mut mean = vec![[0.0; 3]; s.positions.len()];
-        for (t, raw) in surf.raw.iter().enumerate() {
-            for k in 0..surf.nodes_per_triangle {
-                let p = surf.nodes[t][k];
-                mean[p] = [0, 1, 2].map(|q| mean[p][q] + raw[k][q]);
+        for (raw, nodes) in surf.raw.iter().zip(&surf.nodes) {
+            for (r, &p) in raw.iter().zip(nodes).take(surf.nodes_per_triangle) {
+                mean[p] = [0, 1, 2].map(|q| mean[p][q] + r[q]);
             }
         }
         let mut out = Vec::new();
@@ -447,7 +444,10 @@ mod tests {
             mean.push(angle_deg(m, exact));
         }
         let (fit, mean) = (mean_max(&fit), mean_max(&mean));
-        eprintln!("ellipsoid, error vs exact [deg]: fitted mean {:.4} max {:.4}; mean normals mean {:.4} max {:.4}", fit.0, fit.1, mean.0, mean.1);
+        eprintln!(
+            "ellipsoid, error vs exact [deg]: fitted mean {:.4} max {:.4}; mean normals mean {:.4} max {:.4}",
+            fit.0, fit.1, mean.0, mean.1
+        );
         assert!(fit.0 < 0.5 * mean.0 && fit.1 < mean.1, "fitted {fit:?}, mean normals {mean:?}");
     }
 
