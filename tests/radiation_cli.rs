@@ -62,7 +62,8 @@ fn sphere_modes_radiate_as_single_multipoles_and_torsional_modes_are_silent() {
 /// (2026-11-26, dev profile, load ≈ 8): T2 −82.6 dB, T3 −65.1 dB worst, as
 /// the harmonic projection of the FEM modes' own normal velocity
 /// (tools/sphere_leak.py: −82.6, −65.1 dB), so the radiation adds no leak.
-/// Heavy: precompute 3 min 29 s and 8.2 GB peak memory, radiation 12 s. Run with
+/// Heavy: precompute 3 min 29 s and 8.2 GB peak memory, radiation 12 s (the
+/// whole test 240 s, passed 2026-11-26). Run with
 /// `cargo test --test radiation_cli fine_fem_sphere -- --ignored --nocapture`.
 #[test]
 #[ignore]
