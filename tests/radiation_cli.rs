@@ -2,7 +2,9 @@
 //! FEM sphere bank — spheroidal modes radiate as one multipole of degree l,
 //! `p = iρ₀c Σ_m c_lm h_l(kr)/h_l'(ka) Y_l^m` (c_lm the projection of the
 //! mode's normal velocity on Y_l^m), torsional modes (tangential motion)
-//! radiate far less (≥ 35 dB on this coarse mesh; the issue's 60 dB is not yet shown).
+//! radiate far less (≥ 35 dB on this coarse mesh, where the FEM modes
+//! themselves move normally; ≥ 60 dB for exactly tangential fields, and on a
+//! fine FEM sphere in an ignored test).
 
 mod common;
 
@@ -17,10 +19,13 @@ const RADIUS: f64 = 0.05;
 /// A soft, light solid so the lowest sphere modes sit near 1–2 kHz (ka ≈ 1–2).
 const SOFT: [&str; 6] = ["--youngs", "1e8", "--density", "1000", "--poisson", "0.3"];
 
-/// Meshes and solves the sphere bank in `dir` (sphere.bank).
-fn sphere_bank(dir: &std::path::Path) {
+/// The FEM element size of the test's sphere bank [m].
+const H: &str = "0.015";
+
+/// Meshes and solves the sphere bank of element size `h` [m] in `dir` (sphere.bank).
+fn sphere_bank(dir: &std::path::Path, h: &str) {
     let r = RADIUS.to_string();
-    modal(dir, &["mesh", "sphere", "--radius", &r, "--h", "0.015", "--order", "2", "-o", "sphere.msh"]).ok();
+    modal(dir, &["mesh", "sphere", "--radius", &r, "--h", h, "--order", "2", "-o", "sphere.msh"]).ok();
     let mut args = vec!["precompute", "sphere.msh", "-o", "sphere.bank", "--modes", "16", "--no-cache"];
     args.extend(SOFT);
     modal(dir, &args).ok();
@@ -42,8 +47,36 @@ fn point_args(pts: &[[f64; 3]]) -> Vec<String> {
 
 #[test]
 fn sphere_modes_radiate_as_single_multipoles_and_torsional_modes_are_silent() {
+    // The issue asks for ≥ 60 dB. Measured on this coarse mesh (h = 15 mm,
+    // 3 elements per radius, fitted node normals): T2 −54.0 dB, T3
+    // −39.8 dB worst. The FEM modes of this coarse sphere really move
+    // normally (T3 −40.0 dB by harmonic projection with the curved
+    // surface's own normals, tools/sphere_leak.py); the radiation side is
+    // guarded at 60 dB by `exactly_tangential_fields_…`, and a finer FEM
+    // sphere by the ignored test below.
+    sphere_modes_and_torsional_leak(H, -35.0);
+}
+
+/// The issue's 60 dB on an FEM sphere fine enough for its torsional modes
+/// to be tangential to that level: h = 6 mm, 214 347 DOF. Measured
+/// (2026-11-26, dev profile, load ≈ 8): T2 −82.6 dB, T3 −65.1 dB worst, as
+/// the harmonic projection of the FEM modes' own normal velocity
+/// (tools/sphere_leak.py: −82.6, −65.1 dB), so the radiation adds no leak.
+/// Heavy: precompute 3 min 29 s and 8.2 GB peak memory, radiation 12 s (the
+/// whole test 240 s, passed 2026-11-26). Run with
+/// `cargo test --test radiation_cli fine_fem_sphere -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn torsional_modes_of_a_fine_fem_sphere_are_60_db_below_the_spheroidal_ones() {
+    sphere_modes_and_torsional_leak("0.006", -60.0);
+}
+
+/// Each spheroidal mode of the FEM sphere of element size `h` radiates as
+/// one multipole (within 0.5 dB), and every torsional mode's power is
+/// below `guard_db` re the quietest spheroidal mode.
+fn sphere_modes_and_torsional_leak(h: &str, guard_db: f64) {
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), h);
     let pts = points(2.0 * RADIUS);
     let mut args: Vec<String> = ["radiation", "sphere.bank", "--json"].map(String::from).to_vec();
     args.extend(point_args(&pts));
@@ -144,19 +177,14 @@ fn sphere_modes_radiate_as_single_multipoles_and_torsional_modes_are_silent() {
     eprintln!("spheroidal (mode, Hz, W): {spheroidal:?}\ntorsional: {torsional:?}");
     for (i, f, p) in &torsional {
         let db = 10.0 * (p / quietest_spheroidal).log10();
-        // The issue asks for ≥ 60 dB. Measured on this coarse mesh (h = 15 mm,
-        // 3 elements per radius): T2 −54 dB, T3 −39.5 dB. With exact radial
-        // normals the T3 modes still carry normal velocity at −44 dB of the
-        // spheroidal ones: the FEM mode of the faceted sphere really moves
-        // normally. Guarded at 35 dB until a finer mesh shows the 60 dB.
-        assert!(db < -35.0, "torsional mode {i} ({f:.0} Hz) only {db:.1} dB below the spheroidal ones");
+        assert!(db < guard_db, "torsional mode {i} ({f:.0} Hz) only {db:.1} dB below the spheroidal ones");
     }
 }
 
 #[test]
 fn points_inside_the_body_and_bad_air_are_clear_errors() {
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), H);
     modal(dir.path(), &["radiation", "sphere.bank", "--point", "0.01,0,0"]).fails_with("inside the body");
     modal(dir.path(), &["radiation", "sphere.bank", "--point", "1,0,0", "--sound-speed", "0"])
         .fails_with("sound speed");
@@ -174,7 +202,7 @@ fn points_inside_the_body_and_bad_air_are_clear_errors() {
 #[test]
 fn pressure_scales_with_air_density_and_skips_inaudible_modes() {
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), H);
     let run = |extra: &[&str]| {
         let mut a = vec![
             "radiation",
@@ -214,7 +242,7 @@ fn pressure_scales_with_air_density_and_skips_inaudible_modes() {
 #[test]
 fn stored_far_field_matches_the_solve_and_info_shows_power() {
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), H);
     let far = [0.2, -0.15, 0.1];
     let p = format!("{},{},{}", far[0], far[1], far[2]);
     let args = [
@@ -256,7 +284,7 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
 #[test]
 fn strike_hears_the_listener_by_default_linearly_and_audibly() {
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), H);
     modal(dir.path(), &["radiation", "sphere.bank", "--store", "rad.bank"]).ok();
     let strike = |bank: &str, extra: &[&str], out: &str| {
         let mut a =
@@ -361,19 +389,18 @@ fn coarse_panels_at_low_frequency_agree_with_the_full_resolution() {
 /// it is the torsional pattern of degree l, and `∇q` the spheroidal one
 /// (normal velocity `l q / r`). All fields have unit RMS over the surface
 /// nodes. (The FEM's own torsional modes are not exactly tangential: see
-/// the test above; this one isolates the radiation side.) The issue's 60 dB
-/// is not met here yet: see the guard below.
+/// the test above; this one isolates the radiation side.)
 #[test]
 fn exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones() {
-    // The issue asks for 60 dB. Measured (this test, --nocapture): T2 −46.4 dB
-    // at 1600 Hz, −49.4 dB at 2400 Hz; T3 −91.9, −85.4 dB. The floor is the
-    // node-averaged normal (0.94° mean error at corner nodes here): with exact
+    // The issue's 60 dB. Measured (this test, --nocapture): T2 −63.4 dB at
+    // 1600 Hz, −65.2 dB at 2400 Hz; T3 −113.9, −103.4 dB. The floor is the
+    // node normals' error (fitted, src/normals.rs: 0.029° mean here; the mean
+    // of the triangles' normals, 0.77°, gave T2 −46.4 / −49.4 dB); with exact
     // radial node normals the same panel sampling gives −164 dB
     // (`tools/sphere_leak.py BANK --analytic --panels`, docs/radiation.md).
-    // Guarded at the measured level until the node normals are better.
-    const GUARD_DB: f64 = -43.0;
+    const GUARD_DB: f64 = -60.0;
     let dir = temp_dir();
-    sphere_bank(dir.path());
+    sphere_bank(dir.path(), H);
     let mut bank = ModeBank::load(dir.path().join("sphere.bank")).unwrap();
     let cross = |a: [f64; 3], b: [f64; 3]| {
         [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]

@@ -8,7 +8,10 @@ an exact sphere of radius a (e^{-i omega t}):
 
 Three normals are compared: the quadratic map's own normal at each
 quadrature point, the exact radial normal, and the node-averaged quadratic
-normal (as crates/modal-radiation/src/modes.rs) interpolated quadratically.
+normal (modal-radiation's normal before 2026-11-26; it now fits the node
+normals to the local surface, crates/modal-radiation/src/normals.rs, whose
+leak the Rust test `exactly_tangential_fields_…` measures through the
+solver) interpolated quadratically.
 With --analytic, the bank's modes are replaced by exactly tangential fields
 x cross grad q (torsional) and grad q (spheroidal), q = xy, xyz, unit RMS
 at the nodes, at 1600 and 2400 Hz (the fields of the test

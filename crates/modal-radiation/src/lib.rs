@@ -21,6 +21,7 @@
 //! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`solve_with_near`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
+//! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
 //!
@@ -38,6 +39,7 @@ pub mod mfs;
 pub mod modes;
 pub mod multipole;
 pub mod near;
+pub mod normals;
 pub mod quadrature;
 pub mod special;
 

@@ -5,7 +5,7 @@
 //! give the surface velocity `φ_i(x)` [m/s]; a panel's normal velocity is
 //! the mean of `φ · n` over its corners (all surface nodes: a quadratic
 //! surface triangle is four panels), `n` the smooth-surface normal at the
-//! node (see [`normal_velocity`]). Modes whose frequencies lie within a relative
+//! node, fitted to the local surface ([`crate::normals`], [`normal_velocity`]). Modes whose frequencies lie within a relative
 //! `group_tolerance` of each other (degenerate pairs and multiplets) are
 //! solved at their geometric-mean frequency with one factorization: the
 //! transfer varies smoothly with `k` (no resonances in the exterior
@@ -24,6 +24,7 @@ use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
 use crate::multipole::{fit, Multipole, DEFAULT_TOLERANCE};
 use crate::near::NearField;
+use crate::normals::{fit_normals, SurfaceNormals};
 
 /// Options of a bank radiation run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,22 +156,63 @@ pub fn boundary_mesh(bank: &ModeBank) -> Result<BoundaryMesh, RadiationError> {
     }
 }
 
-/// Panels whose normal is within this angle of a node's averaged normal
-/// use the averaged normal at that corner (smooth surface); across
-/// creases (a bar's edges) the panel's own normal is used.
+/// Panels whose normal is within this angle of a node's smooth-surface
+/// normal use that normal at that corner; across creases (a bar's edges)
+/// the panel's own normal is used. Also the angle at which
+/// [`crate::normals`] splits the triangles around a node into smooth sectors.
 pub const CREASE_ANGLE_DEG: f64 = 25.0;
 
-/// Normal of each panel corner: the node's smooth-surface normal where
-/// the surface is smooth, the panel's own normal across creases (see
-/// [`CREASE_ANGLE_DEG`]). The node normal is the area-weighted mean over
-/// the surrounding triangles of the normal of the *curved* 6-node triangle
-/// at that node (`∂x/∂ξ × ∂x/∂η` of the quadratic map) for quadratic
-/// banks, and of the flat panel normals otherwise. (On the FEM sphere the
-/// flat-panel average leaves torsional modes ≈ 50× more normal velocity
-/// energy than the exact radial normal; the quadratic normal matches it.)
+/// Smooth-surface normals of the bank's surface, fitted to the local
+/// surface and never across a crease ([`crate::normals`]).
+pub fn surface_normals(bank: &ModeBank) -> SurfaceNormals {
+    let s = &bank.surface;
+    fit_normals(&s.positions, &s.triangles, s.triangle_edge_nodes.as_deref(), CREASE_ANGLE_DEG)
+}
+
+/// Local node indices (corners 0–2, mid-edge nodes 3–5) of the corners of
+/// the four panels a quadratic triangle is split into
+/// ([`BoundaryMesh::quadratic`]).
+const SPLIT_CORNERS: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
+
+/// Normal of each panel corner: the node's smooth-surface normal
+/// ([`surface_normals`], from the node's sector that holds the panel's
+/// triangle) where it is within [`CREASE_ANGLE_DEG`] of the panel's normal,
+/// the panel's own normal otherwise. `mesh` is the bank's
+/// [`boundary_mesh`]; on any other panel mesh over the bank's nodes each
+/// node's first-sector normal is used.
 pub fn corner_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[[f64; 3]; 3]> {
-    let node = node_normals(bank, mesh);
-    mesh.panels.iter().map(|p| p.corners.map(|c| smooth_or_panel(node[c], p.normal))).collect()
+    corner_normals_of(bank, mesh, &surface_normals(bank))
+}
+
+/// [`corner_normals`] from the bank's [`surface_normals`] `normals`.
+fn corner_normals_of(bank: &ModeBank, mesh: &BoundaryMesh, normals: &SurfaceNormals) -> Vec<[[f64; 3]; 3]> {
+    let s = &bank.surface;
+    let (split, per_triangle) = match &s.triangle_edge_nodes {
+        Some(_) => (&SPLIT_CORNERS[..], 4),
+        None => (&[[0, 1, 2]][..], 1),
+    };
+    // Node `k` of triangle `t` (corners, then mid-edge nodes).
+    let node_of = |t: usize, k: usize| match &s.triangle_edge_nodes {
+        Some(e) if k >= 3 => e[t][k - 3],
+        _ => s.triangles[t][k],
+    };
+    let from_triangles = mesh.panels.len() == per_triangle * s.triangles.len()
+        && mesh.panels.iter().enumerate().all(|(i, p)| {
+            let local = split[i % per_triangle];
+            (0..3).all(|j| p.corners[j] == node_of(i / per_triangle, local[j]))
+        });
+    mesh.panels
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let smooth: [[f64; 3]; 3] = if from_triangles {
+                split[i % per_triangle].map(|k| normals.per_triangle[i / per_triangle][k])
+            } else {
+                p.corners.map(|c| normals.per_node.get(c).copied().unwrap_or([0.0; 3]))
+            };
+            smooth.map(|n| smooth_or_panel(n, p.normal))
+        })
+        .collect()
 }
 
 /// The node's normal where it is within [`CREASE_ANGLE_DEG`] of the panel
@@ -182,65 +224,6 @@ fn smooth_or_panel(node: [f64; 3], panel: [f64; 3]) -> [f64; 3] {
     } else {
         panel
     }
-}
-
-/// Unit smooth-surface normal at every surface node (zero for nodes no
-/// panel touches): see [`corner_normals`].
-pub fn node_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[f64; 3]> {
-    let mut node = vec![[0.0; 3]; mesh.vertices.len()];
-    match &bank.surface.triangle_edge_nodes {
-        Some(edges) if mesh.vertices.len() == bank.surface_node_count() => {
-            for (tri, e) in bank.surface.triangles.iter().zip(edges) {
-                let nodes = [tri[0], tri[1], tri[2], e[0], e[1], e[2]];
-                let x = nodes.map(|i| mesh.vertices[i]);
-                // Reference coordinates (ξ, η) of the six nodes.
-                let at = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
-                for (k, &(xi, eta)) in at.iter().enumerate() {
-                    let n = quadratic_normal(&x, xi, eta);
-                    for q in 0..3 {
-                        node[nodes[k]][q] += n[q];
-                    }
-                }
-            }
-        }
-        _ => {
-            for p in &mesh.panels {
-                for &c in &p.corners {
-                    for (acc, n) in node[c].iter_mut().zip(p.normal) {
-                        *acc += p.area * n;
-                    }
-                }
-            }
-        }
-    }
-    node.iter()
-        .map(|n| {
-            let len = dot(*n, *n).sqrt();
-            if len > 0.0 {
-                n.map(|x| x / len)
-            } else {
-                [0.0; 3]
-            }
-        })
-        .collect()
-}
-
-/// `∂x/∂ξ × ∂x/∂η` of the 6-node triangle (corners 0–2, mid-edge nodes of
-/// edges 01, 12, 20) at `(ξ, η)`: the normal scaled by twice the local area
-/// element.
-fn quadratic_normal(x: &[[f64; 3]; 6], xi: f64, eta: f64) -> [f64; 3] {
-    let l0 = 1.0 - xi - eta;
-    let d_xi = [-(4.0 * l0 - 1.0), 4.0 * xi - 1.0, 0.0, 4.0 * (l0 - xi), 4.0 * eta, -4.0 * eta];
-    let d_eta = [-(4.0 * l0 - 1.0), 0.0, 4.0 * eta - 1.0, -4.0 * xi, 4.0 * xi, 4.0 * (l0 - eta)];
-    let mut a = [0.0; 3];
-    let mut b = [0.0; 3];
-    for k in 0..6 {
-        for q in 0..3 {
-            a[q] += d_xi[k] * x[k][q];
-            b[q] += d_eta[k] * x[k][q];
-        }
-    }
-    crate::geometry::cross(a, b)
 }
 
 /// Normal velocity of mode `mode` on each panel at unit modal velocity
@@ -401,18 +384,19 @@ impl Panels {
         if mesh.vertices.len() != bank.surface_node_count() {
             return Err(RadiationError::Bank("the panel mesh is not the bank's surface".into()));
         }
-        let normals = corner_normals(bank, mesh);
+        let smooth = surface_normals(bank);
+        let normals = corner_normals_of(bank, mesh, &smooth);
         let taps =
             mesh.panels.iter().zip(&normals).map(|(p, n)| [0, 1, 2].map(|k| (p.corners[k], n[k]))).collect();
         let coarse = match (&bank.surface.triangle_edge_nodes, adaptive) {
             (Some(edges), true) => {
-                let node = node_normals(bank, mesh);
                 let m = BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?;
                 let taps = m
                     .panels
                     .iter()
                     .zip(edges)
-                    .map(|(p, e)| e.map(|c| (c, smooth_or_panel(node[c], p.normal))))
+                    .zip(&smooth.per_triangle)
+                    .map(|((p, e), n)| [0, 1, 2].map(|k| (e[k], smooth_or_panel(n[3 + k], p.normal))))
                     .collect();
                 Some(Level::new(m, taps))
             }
