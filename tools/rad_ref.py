@@ -3,8 +3,8 @@
 mode bank by a Galerkin boundary-element solve with bempp-cl.
 
 Packages (pip, in a virtualenv OUTSIDE the repository):
-    python3 -m venv /work/venvs/h15x
-    /work/venvs/h15x/bin/pip install bempp-cl==0.4.2 numba==0.68.1 safetensors==0.8.0
+    python3 -m venv /work/venvs/bempp
+    /work/venvs/bempp/bin/pip install bempp-cl==0.4.2 numba==0.68.1 safetensors==0.8.0
 (numpy 2.4.6 and scipy 1.17.1 come with them). Run with that interpreter.
 
 What it solves (time convention e^{-i omega t}, G = e^{ikr}/(4 pi r)):
@@ -42,6 +42,13 @@ Usage:
         prints (or writes) {"modes": [{"index", "frequency_hz",
         "pressure_pa": [[re, im], ...]}], ...}: the same layout as
         `modal radiation BANK --point ... --json`.
+    rad_ref.py BANK --mode I [--mode ...] --trim OUT.bank
+        writes a copy of BANK holding only the given modes (in ascending
+        order), with its checksum recomputed (docs/bank-format.md), so that
+        a committed test bank stays small.
+    rad_ref.py --merge OUT.json IN.json [IN.json ...]
+        one reference from several runs at the same points (each mode keeps
+        the refine and quadrature it was solved with), modes in index order.
     rad_ref.py --self-test
         pulsating and oscillating spheres (and ka = pi) against closed forms.
     rad_ref.py --compare REF.json MODAL.json [--within-db 40]
@@ -242,8 +249,8 @@ def reference(args):
         p = solver.solve(k, omega * args.air_density, [vn[mi]], args.point)[0]
         print(f"rad_ref: mode {m} at {f:.1f} Hz (k = {k:.2f} 1/m) solved in {time.time() - t1:.1f} s",
               file=sys.stderr)
-        results.append({"index": m, "frequency_hz": f, "refine": args.refine,
-                        "pressure_pa": [[z.real, z.imag] for z in p]})
+        results.append({"index": m, "frequency_hz": f, "refine": args.refine, "quadrature": args.quadrature,
+                        "seconds": time.time() - t1, "pressure_pa": [[z.real, z.imag] for z in p]})
     report = {
         "generator": "tools/rad_ref.py (bempp-cl Galerkin P1/DP1 Burton-Miller)",
         "bank": args.bank,
@@ -264,6 +271,64 @@ def reference(args):
         os.replace(args.out + ".tmp", args.out)
     else:
         print(text)
+
+
+# Tensors with one entry per mode (docs/bank-format.md); the rest describe the
+# surface and the body and are copied as they are.
+PER_MODE = ["frequencies_hz", "damping_ratios", "decay_rates", "residuals", "shapes"]
+
+
+def bank_checksum(tensors, meta):
+    """The bank checksum of docs/bank-format.md: SHA-256 over the tag, each
+    tensor (sorted by name) and each metadata entry but `checksum`."""
+    import hashlib
+    import struct
+    dt = {"float64": "F64", "float32": "F32", "int64": "I64"}
+    h = hashlib.sha256()
+
+    def s(b):
+        h.update(struct.pack("<Q", len(b)))
+        h.update(b)
+    s(b"modal-bank-checksum-v1")
+    for name in sorted(tensors, key=lambda n: n.encode()):
+        a = tensors[name]  # (np.ascontiguousarray would make a scalar 1-D)
+        s(name.encode())
+        s(dt[a.dtype.name].encode())
+        h.update(struct.pack("<Q", a.ndim))
+        h.update(struct.pack(f"<{a.ndim}Q", *a.shape))
+        s(a.astype(a.dtype.newbyteorder("<")).tobytes())
+    for k in sorted((k for k in meta if k != "checksum"), key=str.encode):
+        s(k.encode())
+        s(meta[k].encode())
+    return h.hexdigest()
+
+
+def trim(path, modes, out):
+    """Copy of the bank at `path` with only `modes` (sorted), checksum redone."""
+    from safetensors import safe_open
+    from safetensors.numpy import load_file, save_file
+    tensors = load_file(path)
+    with safe_open(path, "np") as f:
+        meta = dict(f.metadata())
+    if bank_checksum(tensors, meta) != meta.get("checksum"):
+        sys.exit(f"{path}: checksum mismatch (not a modal bank, or damaged)")
+    n = len(tensors["frequencies_hz"])
+    keep = sorted(set(modes))
+    if not keep or not all(0 <= m < n for m in keep):
+        sys.exit(f"--trim needs --mode indices in 0..{n - 1}")
+    extra = [k for k, v in tensors.items() if k not in PER_MODE and v.ndim and v.shape[0] == n
+             and not k.startswith("surface_")]
+    if extra:
+        sys.exit(f"{path}: per-mode tensors this script does not know how to trim: {extra}")
+    for k in PER_MODE:
+        tensors[k] = tensors[k][keep]  # fancy indexing copies, C-contiguous
+    info = json.loads(meta["solve_info"])
+    if info.get("error_estimate_pct") is not None:
+        info["error_estimate_pct"] = [info["error_estimate_pct"][m] for m in keep]
+        meta["solve_info"] = json.dumps(info, separators=(",", ":"))
+    meta["checksum"] = bank_checksum(tensors, meta)
+    save_file(tensors, out, metadata=meta)
+    print(f"rad_ref: wrote {out} with modes {keep} of {n}", file=sys.stderr)
 
 
 def icosphere(subdiv):
@@ -358,6 +423,29 @@ def compare(ref_path, modal_path, within_db):
           f"{len(kept)} mode-points (max {np.max(every):.3f} dB with the nodal points)")
 
 
+def merge(out, inputs):
+    """One reference file from runs at the same points; a mode solved in
+    several runs keeps the last one's."""
+    runs = [json.load(open(p)) for p in inputs]
+    points = runs[0]["points"]
+    if any(r["points"] != points for r in runs):
+        sys.exit("--merge: the inputs were computed at different points")
+    modes = {}
+    for r in runs:
+        for m in r["modes"]:
+            m.setdefault("refine", r["refine"])
+            m.setdefault("quadrature", r["quadrature"])
+            modes[m["index"]] = m
+    report = {k: runs[0][k] for k in ["generator", "bank", "air_density_kg_m3", "sound_speed_m_s", "points"]}
+    report["merged_from"] = [{"refine": r["refine"], "quadrature": r["quadrature"], "triangles": r["triangles"],
+                              "modes": [m["index"] for m in r["modes"]], "seconds": r["seconds"]} for r in runs]
+    report["modes"] = [modes[i] for i in sorted(modes)]
+    with open(out + ".tmp", "w") as fh:
+        fh.write(json.dumps(report, indent=1) + "\n")
+    import os
+    os.replace(out + ".tmp", out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("bank", nargs="?")
@@ -375,11 +463,17 @@ def main():
     ap.add_argument("--self-test", action="store_true")
     ap.add_argument("--compare", nargs=2, metavar=("REF", "MODAL"))
     ap.add_argument("--within-db", type=float, default=40.0)
+    ap.add_argument("--merge", nargs="+", metavar=("OUT", "IN"))
+    ap.add_argument("--trim", metavar="OUT.bank", help="write BANK with only the --mode modes")
     args = ap.parse_args()
     if args.self_test:
         self_test()
+    elif args.merge:
+        merge(args.merge[0], args.merge[1:])
     elif args.compare:
         compare(*args.compare, args.within_db)
+    elif args.bank and args.trim:
+        trim(args.bank, args.mode, args.trim)
     elif args.bank:
         for p in args.point:
             if len(p) != 3:
