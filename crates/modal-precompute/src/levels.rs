@@ -206,25 +206,22 @@ pub(crate) fn solve_to_accuracy(
             ));
             return Ok((bank, warnings));
         }
-        let predicted = fine.memory as f64 * (1.0 / step).powi(4);
         let guard = request.memory_limit_bytes.or_else(memory_guard_bytes);
-        let predicted_s = fine.seconds * (1.0 / step).powi(TIME_EXPONENT);
-        let over_time = spent + predicted_s > TIME_BUDGET_S;
-        if refinement == MAX_REFINEMENTS || over_time || guard.is_some_and(|g| predicted > g as f64) {
-            let why = match guard {
-                Some(g) if predicted > g as f64 => format!(
-                    "the next finer level (cell {:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB",
-                    fine.cell_m * step,
+        let next = NextLevel { memory: fine.memory, seconds: fine.seconds, spent, step };
+        if let Some(stop) = next.refused(refinement, guard) {
+            let cell = fine.cell_m * step;
+            let why = match stop {
+                Stop::Memory { predicted, guard } => format!(
+                    "the next finer level (cell {cell:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB",
                     predicted / 1e9,
-                    g as f64 / 1e9
+                    guard as f64 / 1e9
                 ),
-                _ if over_time => format!(
-                    "the next finer level (cell {:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
+                Stop::Time { predicted_s } => format!(
+                    "the next finer level (cell {cell:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
                      time budget of {TIME_BUDGET_S:.0} s (about --cell {:.2e} m would reach the target)",
-                    fine.cell_m * step,
                     fine.cell_m * wanted.min(MAX_STEP)
                 ),
-                _ => format!("stopped after {MAX_REFINEMENTS} refinements"),
+                Stop::Refinements => format!("stopped after {MAX_REFINEMENTS} refinements"),
             };
             warnings.push(format!("{reached} ({} DOF): {why}", fine.dofs));
             return Ok((bank, warnings));
@@ -247,6 +244,42 @@ pub(crate) fn solve_to_accuracy(
         }
     }
     unreachable!("the loop returns")
+}
+
+/// Why a refinement is not started.
+#[derive(Clone, Debug, PartialEq)]
+enum Stop {
+    /// [`MAX_REFINEMENTS`] reached.
+    Refinements,
+    /// Predicted solver memory [bytes] above the guard.
+    Memory { predicted: f64, guard: u64 },
+    /// Predicted wall time [s] of the next level would pass [`TIME_BUDGET_S`].
+    Time { predicted_s: f64 },
+}
+
+/// What is known before the next, finer level: the last level's solver memory [bytes]
+/// and wall time [s], the time spent on all levels so far [s], and the size step.
+struct NextLevel {
+    memory: u64,
+    seconds: f64,
+    spent: f64,
+    step: f64,
+}
+
+impl NextLevel {
+    /// Why refinement number `refinement` (0-based) is not started, if it is not: memory
+    /// `m · (1/step)⁴` above `guard`, or `spent + t · (1/step)⁶` beyond [`TIME_BUDGET_S`]
+    /// (see the module docs); memory first, it is the harder limit.
+    fn refused(&self, refinement: usize, guard: Option<u64>) -> Option<Stop> {
+        let predicted = self.memory as f64 * (1.0 / self.step).powi(4);
+        let predicted_s = self.seconds * (1.0 / self.step).powi(TIME_EXPONENT);
+        match guard {
+            Some(guard) if predicted > guard as f64 => Some(Stop::Memory { predicted, guard }),
+            _ if self.spent + predicted_s > TIME_BUDGET_S => Some(Stop::Time { predicted_s }),
+            _ if refinement == MAX_REFINEMENTS => Some(Stop::Refinements),
+            _ => None,
+        }
+    }
 }
 
 fn describe_worst(worst: Option<f64>, target: &AccuracyTarget) -> String {
@@ -298,4 +331,28 @@ fn memory_guard_bytes() -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024 / 4 * 3)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refinement_stops_for_memory_then_time_then_count() {
+        // 1 GB and 2 s at step 0.5: the next level needs 16 GB and 128 s.
+        let next = NextLevel { memory: 1_000_000_000, seconds: 2.0, spent: 3.0, step: 0.5 };
+        assert_eq!(
+            next.refused(0, Some(8_000_000_000)),
+            Some(Stop::Memory { predicted: 16e9, guard: 8_000_000_000 })
+        );
+        assert_eq!(next.refused(0, Some(32_000_000_000)), Some(Stop::Time { predicted_s: 128.0 }));
+        // Step 0.8: 2.44 GB and 7.6 s, 10.6 s with the 3 s spent: inside both limits.
+        let cheap = NextLevel { step: 0.8, ..next };
+        assert_eq!(cheap.refused(0, Some(8_000_000_000)), None);
+        assert_eq!(cheap.refused(0, None), None);
+        assert_eq!(cheap.refused(MAX_REFINEMENTS, None), Some(Stop::Refinements));
+        // The time spent counts: 55 s already spent leaves no room for 7.6 s more.
+        let late = NextLevel { spent: 55.0, ..cheap };
+        assert!(matches!(late.refused(0, None), Some(Stop::Time { .. })));
+    }
 }
