@@ -174,7 +174,7 @@ impl PipelineProvider<'_> {
             .count();
         let entry = match (&self.cache, self.bank_key(request)?) {
             (Some(cache), Some(key)) => {
-                let key = CacheKey::new("modal-radiation-v2")
+                let key = CacheKey::new("modal-radiation-v3")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)
