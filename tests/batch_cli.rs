@@ -421,3 +421,31 @@ fn manifest_and_merge_mistakes_are_one_clear_line() {
     assert_eq!(partial.json()["complete"], false);
     assert_eq!(load(&d.join("all.json"))["complete"], false);
 }
+
+/// Banks of surface meshes carry the per-mode error estimate like `modal precompute`'s
+/// (issue 14), unless the manifest turns it off with `accuracy = "off"`.
+#[test]
+fn surface_assets_get_the_error_estimate_unless_the_manifest_turns_it_off() {
+    let dir = temp_dir();
+    let sphere = modal_tetra::shapes::icosphere(0.05, 2);
+    std::fs::create_dir_all(dir.path().join("props")).unwrap();
+    for name in ["estimated", "plain"] {
+        let file = std::fs::File::create(dir.path().join(format!("props/{name}.obj"))).unwrap();
+        modal_tetra::write_obj(&sphere, file).unwrap();
+    }
+    let text = "[defaults]\nmaterial = \"steel\"\nmodes = 4\ncell = 0.02\n\n\
+                [[assets]]\npath = \"props/estimated.obj\"\n\n\
+                [[assets]]\npath = \"props/plain.obj\"\naccuracy = \"off\"\n";
+    std::fs::write(dir.path().join("library.toml"), text).unwrap();
+    modal(dir.path(), &["precompute-batch", "library.toml", "--out", "out", "--cache-dir", "cache"], &[])
+        .ok();
+    let estimate = |name: &str| {
+        let bank = modal_bank::ModeBank::load(dir.path().join(format!("out/props/{name}.bank"))).unwrap();
+        (bank.mode_count(), bank.info.error_estimate_pct)
+    };
+    let (modes, estimated) = estimate("estimated");
+    assert_eq!(estimated.len(), modes, "one estimate per mode");
+    assert!(estimated.iter().all(|e| e.is_some_and(|e| e > 0.0)), "{estimated:?}");
+    let (_, plain) = estimate("plain");
+    assert!(plain.is_empty(), "accuracy = \"off\": no estimate, got {plain:?}");
+}

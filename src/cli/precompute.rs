@@ -40,6 +40,20 @@ fn describe(stage: &Stage) -> String {
     }
 }
 
+/// Environment variable that replaces the solver's memory guard (75 % of the available
+/// memory) by this many GB: for reference solves on a machine known to have the room.
+pub const MEMORY_LIMIT_ENV: &str = "MODAL_MEMORY_LIMIT_GB";
+
+/// The memory limit [bytes] set by [`MEMORY_LIMIT_ENV`], if any.
+fn memory_limit_from_env() -> Result<Option<u64>> {
+    let Some(text) = std::env::var_os(MEMORY_LIMIT_ENV) else { return Ok(None) };
+    let text = text.to_string_lossy();
+    match text.trim().parse::<f64>() {
+        Ok(gb) if gb.is_finite() && gb > 0.0 => Ok(Some((gb * 1e9) as u64)),
+        _ => anyhow::bail!("{MEMORY_LIMIT_ENV} must be a positive number of GB, got {text:?}"),
+    }
+}
+
 /// The cache the flags ask for (none with `--no-cache`).
 pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Option<BankCache> {
     if disabled {
@@ -59,6 +73,7 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     request.max_freq_hz = args.max_freq;
     request.fix_box = args.fix_box;
     request.threads = args.threads;
+    request.memory_limit_bytes = memory_limit_from_env()?;
     request.accuracy = args
         .accuracy
         .0

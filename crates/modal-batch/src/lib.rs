@@ -32,7 +32,7 @@ mod shard;
 
 pub use catalogue::{merge, Catalogue, CatalogueEntry, MergeReport, ShardInfo, CATALOGUE_FILE};
 pub use glob::{expand as expand_glob, Pattern};
-pub use manifest::{Asset, Manifest, Options};
+pub use manifest::{Accuracy, Asset, Manifest, Options};
 pub use run::{run_asset, run_batch, BatchOptions, Event};
 pub use shard::{Shard, ShardEnv, SHARD_COUNT_ENV};
 

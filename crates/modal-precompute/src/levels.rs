@@ -4,7 +4,12 @@
 //! 1. Level 0 is the requested discretization (the mesher's default sizing, or the
 //!    user's `--cell`). A coarser level (the tetrahedralizer's cell × [`COARSE_FACTOR`];
 //!    its whole sizing field scales with the cell) is solved beside it and
-//!    [`crate::accuracy::estimate`] gives each mode's error.
+//!    [`crate::accuracy::estimate`] gives each mode's error. Richardson compares two
+//!    discretizations of the *same* solid: a coarse level whose mesh falls into a
+//!    different number of free parts (measured: two boxes sharing an edge, kept apart
+//!    at the fine cell, joined through faces at 1.5×, estimate 137× the true error) is
+//!    another object, so it is replaced by one at [`MILD_COARSE_FACTOR`] (the part
+//!    count is the number of rigid-body modes removed).
 //! 2. While the largest estimate over the lowest [`AccuracyTarget::modes`] modes is
 //!    above the target (or unknown), the element sizes shrink by the factor the
 //!    estimate predicts, `s' = s · 0.9 (target / worst)^{1/p}` (clamped to
@@ -13,7 +18,10 @@
 //!    nested-dissection factor ∝ DOF^{4/3}), exceeds the memory guard (75 % of the
 //!    available memory, the eigensolver's own default limit) is not attempted: the
 //!    bank says what it reached and what the next level would need. So does a level
-//!    refused by the mesher's or the solver's own guards.
+//!    refused by the mesher's or the solver's own guards, and a level whose predicted
+//!    wall time, `t · (s / s')⁶` (`t`: the last level's; a nested-dissection
+//!    factorization costs ∝ DOF², measured ∝ s⁻⁵·¹ … s⁻⁶·⁰ on the corpus holed sphere),
+//!    would take the run past [`TIME_BUDGET_S`].
 //! 3. An explicit `--cell` is a prescribed discretization: it gets its estimate and a
 //!    warning when the target is missed, with the cell that would reach it, but it is
 //!    not refined. A tet mesh file (or an in-memory mesh) cannot be re-meshed here: it
@@ -31,10 +39,21 @@ use crate::{is_surface_file, MeshSource, PrecomputeError, Request, Stage};
 
 /// Part of the cache key of banks made to an accuracy target; bump when the levels
 /// or the estimate change.
-pub const LEVELS_VERSION: &str = "levels-3";
+pub const LEVELS_VERSION: &str = "levels-4";
 
 /// Element sizes of the coarse level relative to the fine one.
 pub const COARSE_FACTOR: f64 = 1.5;
+
+/// Coarse factor used instead of [`COARSE_FACTOR`] when the coarser level's mesh has a
+/// different number of free parts than the fine one (√1.5: half the step).
+pub const MILD_COARSE_FACTOR: f64 = 1.224_744_871_391_589;
+
+/// A refinement is not started when the run (all levels so far plus the predicted next
+/// one) would exceed this many seconds of wall time; the bank says what was reached.
+pub const TIME_BUDGET_S: f64 = 60.0;
+
+/// Exponent of the predicted time of a level in its size step (see the module docs).
+const TIME_EXPONENT: i32 = 6;
 
 /// Smallest and largest size step of one refinement.
 pub const MIN_STEP: f64 = 0.4;
@@ -80,6 +99,8 @@ struct Level {
     dofs: usize,
     memory: u64,
     size_factor: f64,
+    /// Wall time of this level (mesh, assembly, solve) [s].
+    seconds: f64,
     /// The tetrahedralizer's cell of this level [m].
     cell_m: f64,
     warnings: Vec<String>,
@@ -97,11 +118,21 @@ fn solve_level(
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Level, PrecomputeError> {
     progress(Stage::Level { index, size_factor });
+    let start = std::time::Instant::now();
     let level_cell = base_cell.map(|c| c * size_factor);
     let (assembled, analysis) = assemble_and_analyze(wide, true, level_cell, progress)?;
     let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
     let cell_m = assembled.cell_m.or(level_cell).unwrap_or(f64::NAN);
-    Ok(Level { dofs: bank.info.dofs, bank, memory, size_factor, cell_m, warnings: assembled.warnings })
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(Level {
+        dofs: bank.info.dofs,
+        bank,
+        memory,
+        size_factor,
+        seconds,
+        cell_m,
+        warnings: assembled.warnings,
+    })
 }
 
 /// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes.
@@ -135,6 +166,24 @@ pub(crate) fn solve_to_accuracy(
             return Ok((trim(&fine.bank, request, None).0, warnings));
         }
     };
+    // Wall time of the levels solved so far (the time budget's clock).
+    let mut spent = fine.seconds + coarse.seconds;
+    let parts = |level: &Level| level.bank.info.rigid_modes_removed;
+    if parts(&coarse) != parts(&fine) {
+        // Another object (see the module docs): a milder coarsening, if it keeps the parts.
+        if let Ok(mild) = solve_level(&wide, 1, base_cell, MILD_COARSE_FACTOR, key, progress) {
+            spent += mild.seconds;
+            if parts(&mild) == parts(&fine) {
+                coarse = mild;
+            } else {
+                warnings.push(format!(
+                    "the coarser levels of the error estimate (element sizes × {COARSE_FACTOR} and × \
+                     {MILD_COARSE_FACTOR:.2}) split or join parts of the mesh: the estimate compares different \
+                     objects and is only a rough bound"
+                ));
+            }
+        }
+    }
     let prescribed = request.surface.cell.is_some();
     for refinement in 0.. {
         let est = estimate(&fine.bank, &coarse.bank, fine.dofs, coarse.dofs);
@@ -158,14 +207,22 @@ pub(crate) fn solve_to_accuracy(
             return Ok((bank, warnings));
         }
         let predicted = fine.memory as f64 * (1.0 / step).powi(4);
-        let guard = memory_guard_bytes();
-        if refinement == MAX_REFINEMENTS || guard.is_some_and(|g| predicted > g as f64) {
+        let guard = request.memory_limit_bytes.or_else(memory_guard_bytes);
+        let predicted_s = fine.seconds * (1.0 / step).powi(TIME_EXPONENT);
+        let over_time = spent + predicted_s > TIME_BUDGET_S;
+        if refinement == MAX_REFINEMENTS || over_time || guard.is_some_and(|g| predicted > g as f64) {
             let why = match guard {
                 Some(g) if predicted > g as f64 => format!(
                     "the next finer level (cell {:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB",
                     fine.cell_m * step,
                     predicted / 1e9,
                     g as f64 / 1e9
+                ),
+                _ if over_time => format!(
+                    "the next finer level (cell {:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
+                     time budget of {TIME_BUDGET_S:.0} s (about --cell {:.2e} m would reach the target)",
+                    fine.cell_m * step,
+                    fine.cell_m * wanted.min(MAX_STEP)
                 ),
                 _ => format!("stopped after {MAX_REFINEMENTS} refinements"),
             };
@@ -174,6 +231,7 @@ pub(crate) fn solve_to_accuracy(
         }
         match solve_level(&wide, refinement + 2, base_cell, fine.size_factor * step, key, progress) {
             Ok(mut finer) => {
+                spent += finer.seconds;
                 warnings.append(&mut finer.warnings);
                 coarse = std::mem::replace(&mut fine, finer);
             }

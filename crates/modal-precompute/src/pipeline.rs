@@ -41,6 +41,10 @@ pub struct Request {
     /// Per-mode error estimate and the accuracy to reach (surface meshes only, see
     /// `crate::levels`); `None`: one solve at the given discretization, no estimate.
     pub accuracy: Option<AccuracyTarget>,
+    /// Memory the eigensolver may plan for [bytes], also the guard of the accuracy
+    /// levels; `None`: 75 % of the available memory (the eigensolver's default).
+    /// Not part of the cache key: it decides whether a solve is attempted, not its result.
+    pub memory_limit_bytes: Option<u64>,
 }
 
 impl Request {
@@ -59,6 +63,7 @@ impl Request {
             fix_box: None,
             threads: None,
             accuracy: None,
+            memory_limit_bytes: None,
         }
     }
 
@@ -334,6 +339,7 @@ pub(crate) fn solve_bank(
         max_freq_hz: request.max_freq_hz,
         max_modes: request.max_modes,
         threads: request.threads.unwrap_or(0),
+        memory_limit_bytes: request.memory_limit_bytes,
         ..EigenOptions::default()
     };
     let rigid_ref = (rigid.ncols() > 0).then(|| rigid.as_ref());
