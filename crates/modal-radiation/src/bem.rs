@@ -19,9 +19,11 @@
 //!
 //! Discretisation: piecewise-constant `q` on flat panels; `p` piecewise
 //! constant on the panels or on clusters of panels ([`crate::cluster`]:
-//! fewer unknowns where the wavelength allows, every panel still
-//! integrated exactly as before), collocation at one panel centroid per
-//! cluster, dense complex LU with partial pivoting (faer, sequential, so
+//! fewer unknowns where the wavelength allows; every panel keeps its own
+//! velocity and geometry), collocation at one panel centroid per
+//! cluster (assembly and its quadrature rules: [`crate::assembly`]; far
+//! clusters are summed as points with the velocity's first two moments),
+//! dense complex LU with partial pivoting (faer, sequential, so
 //! the result does not depend on the thread count) below
 //! [`ITERATIVE_MIN_UNKNOWNS`] unknowns, restarted GMRES ([`crate::gmres`],
 //! LU if it fails to converge) above. Rows are assembled
@@ -32,12 +34,13 @@ use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::{Mat, MatMut, MatRef, Par};
-use rayon::prelude::*;
 
+use crate::assembly::assemble;
+pub use crate::assembly::{AGGREGATE_RATIO, CLUSTER_NEAR_RATIO, FAR_POINT_RATIO, MID_POINT_RATIO};
 use crate::cluster::Clusters;
 use crate::error::RadiationError;
-use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
-use crate::kernels::{Kernels, PanelIntegrals};
+use crate::geometry::BoundaryMesh;
+use crate::kernels::Kernels;
 use crate::near::NearField;
 
 /// Properties of the air.
@@ -169,20 +172,33 @@ pub fn solve_clustered(
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
     let near = NearField::new(mesh);
-    solve_with_near(mesh, &near, clusters, air, frequency_hz, velocities, formulation)
+    let disc = Discretization { mesh, near: &near, clusters, aggregate: true };
+    solve_on(&disc, air, frequency_hz, velocities, formulation)
 }
 
-/// [`solve_clustered`] with the mesh's near field computed beforehand
-/// (`NearField::new(mesh)`, reused across frequencies).
-pub fn solve_with_near(
-    mesh: &BoundaryMesh,
-    near: &NearField,
-    clusters: &Clusters,
+/// What a solve is assembled on.
+#[derive(Clone, Copy, Debug)]
+pub struct Discretization<'a> {
+    /// The panels (geometry and normal velocity).
+    pub mesh: &'a BoundaryMesh,
+    /// Their near field (`NearField::new(mesh)`, reused across frequencies).
+    pub near: &'a NearField,
+    /// The pressure unknowns.
+    pub clusters: &'a Clusters,
+    /// Sum far clusters as points ([`crate::assembly`]); off, every panel is
+    /// integrated on its own (the reference of the error measurements).
+    pub aggregate: bool,
+}
+
+/// [`solve_clustered`] on a prepared [`Discretization`].
+pub fn solve_on(
+    disc: &Discretization<'_>,
     air: Air,
     frequency_hz: f64,
     velocities: &[Vec<c64>],
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
+    let (mesh, clusters) = (disc.mesh, disc.clusters);
     if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
         return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
     }
@@ -200,7 +216,12 @@ pub fn solve_with_near(
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
-    let (mut at, mut rhs) = assemble(mesh, near, clusters, k, formulation, velocities, iwr);
+    let alpha = match formulation {
+        Formulation::BurtonMiller => c64::new(0.0, 1.0 / k),
+        Formulation::Conventional => c64::new(0.0, 0.0),
+    };
+    let q: Vec<Vec<c64>> = velocities.iter().map(|v| v.iter().map(|z| z * iwr).collect()).collect();
+    let (mut at, mut rhs) = assemble(mesh, disc.near, clusters, &Kernels::new(k), alpha, &q, disc.aggregate);
     let pressures = iterative_solve(&at, clusters.len(), &rhs, nrhs)
         .or_else(|| lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs))
         .ok_or(RadiationError::Singular { frequency_hz })?;
@@ -213,159 +234,6 @@ pub fn solve_with_near(
             normal_velocity: velocities[f].clone(),
         })
         .collect())
-}
-
-/// A cluster seen as a test region: its panels with area weights, its
-/// area-weighted centre and normal, and its radius about the centre.
-struct TestRegion {
-    members: Vec<(usize, f64)>,
-    centre: [f64; 3],
-    normal: [f64; 3],
-    radius: f64,
-}
-
-fn test_regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<TestRegion> {
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); clusters.len()];
-    for (p, &c) in clusters.of_panel.iter().enumerate() {
-        members[c].push(p);
-    }
-    members
-        .into_iter()
-        .map(|m| {
-            let area: f64 = m.iter().map(|&p| mesh.panels[p].area).sum();
-            let mean = |f: &dyn Fn(usize) -> [f64; 3]| {
-                [0, 1, 2].map(|k| m.iter().map(|&p| mesh.panels[p].area * f(p)[k]).sum::<f64>() / area)
-            };
-            let centre = mean(&|p| mesh.panels[p].centroid);
-            let n = mean(&|p| mesh.panels[p].normal);
-            let len = norm(n);
-            let radius = m
-                .iter()
-                .map(|&p| norm(sub(mesh.panels[p].centroid, centre)) + mesh.panels[p].diameter)
-                .fold(0.0, f64::max);
-            let members = m.iter().map(|&p| (p, mesh.panels[p].area / area)).collect();
-            TestRegion { members, centre, normal: n.map(|x| x / len), radius }
-        })
-        .collect()
-}
-
-/// Panels closer than this many (cluster radius + panel diameter) to a
-/// cluster's centre are tested at every member centroid; farther ones at
-/// the cluster's centre alone (the mean of a smooth kernel over the
-/// cluster, to second order in its size). Also every panel within the
-/// cluster radius plus [`MID_POINT_RATIO`] of its diameters, so that every
-/// pair of the near field ([`crate::near`]) is met at its member point and
-/// the cluster's centre never needs the adaptive rule.
-pub const CLUSTER_NEAR_RATIO: f64 = 1.5;
-
-/// Panels farther than this many diameters from the point (and with
-/// `k·h ≤ 1`) are integrated by their centroid alone: relative error
-/// `O((h/r)²)` of the smooth kernel: measured ≤ 0.4 % at k·h = 0, ≤ 2 %
-/// at k·h = 1 (the phase across the panel).
-pub const FAR_POINT_RATIO: f64 = 8.0;
-
-/// Panels between this many and [`FAR_POINT_RATIO`] diameters from the
-/// point (and with `k·h ≤ 1`) are integrated by the 3-point rule (degree
-/// 2); closer ones by the adaptive 7-point rule. Relative error of the four
-/// kernels against the adaptive rule from 3 diameters on: ≤ 6.8·10⁻⁴
-/// (k·d ≤ 1), against ≤ 2·10⁻² for the centroid rule beyond
-/// [`FAR_POINT_RATIO`] (test `far_rules_meet_their_stated_error`).
-pub const MID_POINT_RATIO: f64 = 3.0;
-
-/// The four panel integrals of `panel` seen from `x`: one centroid point
-/// when far ([`FAR_POINT_RATIO`]), three points at mid range
-/// ([`MID_POINT_RATIO`]), the adaptive rule otherwise.
-fn integrals(
-    kern: &Kernels,
-    mesh: &BoundaryMesh,
-    panel: &Panel,
-    x: [f64; 3],
-    nx: [f64; 3],
-) -> PanelIntegrals {
-    let d = sub(panel.centroid, x);
-    let r2 = dot(d, d);
-    let smooth = kern.k() * panel.diameter <= 1.0;
-    let (far, mid) = (FAR_POINT_RATIO * panel.diameter, MID_POINT_RATIO * panel.diameter);
-    if smooth && r2 > far * far {
-        kern.point(x, nx, panel.centroid, panel.normal, panel.area)
-    } else if smooth && r2 > mid * mid {
-        kern.three_point(mesh, panel, x, nx)
-    } else {
-        kern.panel(mesh, panel, x, nx)
-    }
-}
-
-/// Row `i` (cluster `i`) of the system matrix `A` is stored as column `i`
-/// of `at` (column-major `n × n`, `n` clusters), i.e. `at = Aᵀ`. The
-/// equation of a cluster is the area-weighted mean of the collocation
-/// equations at its panels' centroids (each balanced about its own panel,
-/// which a single off-centre point of the hypersingular equation is not);
-/// entry `(i, c)` sums the integrals over the panels of cluster `c`. A
-/// single panel per cluster is plain centroid collocation. The right-hand
-/// sides come back row-major `n × nrhs`.
-fn assemble(
-    mesh: &BoundaryMesh,
-    near_field: &NearField,
-    clusters: &Clusters,
-    k: f64,
-    formulation: Formulation,
-    velocities: &[Vec<c64>],
-    iwr: c64,
-) -> (Vec<c64>, Vec<c64>) {
-    let n = clusters.len();
-    let nrhs = velocities.len();
-    let alpha = match formulation {
-        Formulation::BurtonMiller => c64::new(0.0, 1.0 / k),
-        Formulation::Conventional => c64::new(0.0, 0.0),
-    };
-    let kern = Kernels::new(k);
-    let zero = c64::new(0.0, 0.0);
-    let regions = test_regions(mesh, clusters);
-    let mut at = vec![zero; n * n];
-    let mut rhs = vec![zero; n * nrhs];
-    at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
-        let region = &regions[i];
-        let single = region.members.len() == 1;
-        // Per member, its near-field row and a cursor into it (panels ascend with j).
-        let rows: Vec<_> = region.members.iter().map(|&(t, _)| near_field.row(t)).collect();
-        let mut cursor = vec![0usize; rows.len()];
-        for (j, pj) in mesh.panels.iter().enumerate() {
-            let dist = norm(sub(pj.centroid, region.centre));
-            let near = single
-                || dist < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter)
-                || dist < region.radius + MID_POINT_RATIO * pj.diameter;
-            let (mut a, mut op) = (zero, zero);
-            if near {
-                for (m, &(t, w)) in region.members.iter().enumerate() {
-                    let pt = &mesh.panels[t];
-                    let (panels, statics) = rows[m];
-                    while cursor[m] < panels.len() && (panels[cursor[m]] as usize) < j {
-                        cursor[m] += 1;
-                    }
-                    let ints = if t == j {
-                        kern.self_integrals(mesh, pj)
-                    } else if cursor[m] < panels.len() && panels[cursor[m]] as usize == j {
-                        kern.near(mesh, pj, pt.centroid, pt.normal, &statics[cursor[m]])
-                    } else {
-                        integrals(&kern, mesh, pj, pt.centroid, pt.normal)
-                    };
-                    let half = if t == j { 0.5 } else { 0.0 };
-                    a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
-                    // −(L + α(½ + K')) q_j
-                    op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
-                }
-            } else {
-                let ints = integrals(&kern, mesh, pj, region.centre, region.normal);
-                a = -ints.dg_dny - alpha * ints.d2g;
-                op = -(ints.g + alpha * ints.dg_dnx);
-            }
-            row[clusters.of_panel[j]] += a;
-            for (f, v) in velocities.iter().enumerate() {
-                b[f] += op * (v[j] * iwr);
-            }
-        }
-    });
-    (at, rhs)
 }
 
 /// Systems with at least this many unknowns are solved by GMRES
@@ -429,6 +297,47 @@ fn lu_solve_transposed(at: &mut [c64], n: usize, rhs: &mut [c64], nrhs: usize) -
 mod tests {
     use super::*;
 
+    /// Measured (`cargo test -p modal-radiation --lib far_clusters -- --nocapture`):
+    /// level change at 12 points at twice the radius when far clusters are
+    /// summed as points instead of panel by panel.
+    #[test]
+    fn far_clusters_summed_as_points_match_panel_by_panel() {
+        use crate::cluster::Adjacency;
+        let (v, t) = modal_mesh::icosphere(4);
+        let verts = v.iter().map(|p| [0.1 * p[0], 0.06 * p[1], 0.04 * p[2]]).collect();
+        let mesh = BoundaryMesh::new(verts, &t).unwrap();
+        let near = NearField::new(&mesh);
+        // A bending-like field: sign changes along x and z.
+        let vel: Vec<c64> = mesh
+            .panels
+            .iter()
+            .map(|p| c64::new((40.0 * p.centroid[0]).cos() * p.normal[2] + 0.3 * p.normal[0], 0.0))
+            .collect();
+        let air = Air::default();
+        for f in [800.0, 3000.0] {
+            let k = 2.0 * std::f64::consts::PI * f / air.sound_speed_m_s;
+            let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), (0.5 / k).min(0.025));
+            assert!(clusters.len() < mesh.len() / 2, "{} clusters", clusters.len());
+            let field = |aggregate| {
+                let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate };
+                solve_on(&disc, air, f, std::slice::from_ref(&vel), Formulation::BurtonMiller)
+                    .unwrap()
+                    .remove(0)
+            };
+            let (each, summed) = (field(false), field(true));
+            let mut worst = 0.0f64;
+            for i in 0..12 {
+                let (th, ph) = (0.3 + 0.23 * i as f64, 1.1 * i as f64);
+                let x = [0.2 * th.sin() * ph.cos(), 0.2 * th.sin() * ph.sin(), 0.2 * th.cos()];
+                let (a, b) = (each.pressure_at(&mesh, x).unwrap(), summed.pressure_at(&mesh, x).unwrap());
+                worst = worst.max((20.0 * (b.norm() / a.norm()).log10()).abs());
+            }
+            eprintln!("{f} Hz, {} clusters: largest level change {worst:.4} dB", clusters.len());
+            assert!(each.pressure != summed.pressure, "no cluster was summed");
+            assert!(worst < 0.1, "{f} Hz: {worst} dB");
+        }
+    }
+
     #[test]
     fn gmres_and_lu_agree_on_a_burton_miller_system() {
         // 1280 panels (above ITERATIVE_MIN_UNKNOWNS), an ellipsoid, ka ≈ 2.
@@ -440,10 +349,11 @@ mod tests {
         let vel: Vec<c64> =
             mesh.panels.iter().map(|p| c64::new(p.normal[0] + 0.3 * p.normal[2], 0.0)).collect();
         let k = 20.0;
-        let iwr = c64::new(0.0, k * 343.0 * 1.21);
+        let q: Vec<c64> = vel.iter().map(|v| v * c64::new(0.0, k * 343.0 * 1.21)).collect();
         let near = NearField::new(&mesh);
-        let (mut at, mut rhs) =
-            assemble(&mesh, &near, &Clusters::identity(n), k, Formulation::BurtonMiller, &[vel], iwr);
+        let kern = Kernels::new(k);
+        let alpha = c64::new(0.0, 1.0 / k);
+        let (mut at, mut rhs) = assemble(&mesh, &near, &Clusters::identity(n), &kern, alpha, &[q], true);
         let it = iterative_solve(&at, n, &rhs, 1).expect("GMRES converges");
         let lu = lu_solve_transposed(&mut at, n, &mut rhs, 1).unwrap();
         let diff: f64 = (0..n).map(|i| (it[(i, 0)] - lu[(i, 0)]).norm_sqr()).sum::<f64>().sqrt();

@@ -212,21 +212,8 @@ impl Kernels {
     /// All four kernels at one quadrature point, times the weight `w`.
     #[inline]
     pub fn point(&self, x: [f64; 3], nx: [f64; 3], y: [f64; 3], ny: [f64; 3], w: f64) -> PanelIntegrals {
-        let k = self.k;
-        let d = sub(y, x);
-        let r2 = dot(d, d);
-        let r = r2.sqrt();
-        let kr = k * r;
-        let (s, c) = kr.sin_cos();
-        let e = c64::new(c, s) * (w / (FOUR_PI * r));
-        let g = e;
-        // G'(r) r / G(r)... written out: G' = e^{ikr}(ikr − 1)/(4πr²).
-        let gp_over_r = e * c64::new(-1.0, kr) / r2; // G'(r)/r · w
-        let dny = dot(d, ny);
-        let dnx = dot(d, nx);
-        let d2g = e / r2
-            * (c64::new(1.0, -kr) * dot(nx, ny) - c64::new(3.0 - kr * kr, -3.0 * kr) * (dnx * dny / r2));
-        PanelIntegrals { g, dg_dny: gp_over_r * dny, dg_dnx: -gp_over_r * dnx, d2g }
+        let p = PointKernel::new(self.k, x, nx, y);
+        PanelIntegrals { g: p.g * w, dg_dny: p.dg_dny(ny) * w, dg_dnx: p.dg_dnx * w, d2g: p.d2g(ny) * w }
     }
 
     /// Integrals over `panel` at its own centroid (see the module doc).
@@ -263,6 +250,64 @@ impl Kernels {
             dg_dnx: c64::new(0.0, 0.0),
             d2g: (c64::new(0.0, 2.0 * std::f64::consts::PI * k) - hyper) / FOUR_PI,
         }
+    }
+}
+
+/// The kernels between a point `x` (normal `n_x`) and a source point `y`
+/// for any source normal `n_y`: one `sincos`, then each kernel is linear in
+/// `n_y` (the cluster sums of [`crate::assembly`] use a summed normal and a
+/// dipole moment in its place).
+#[derive(Clone, Copy, Debug)]
+pub struct PointKernel {
+    /// `G(x, y)`.
+    pub g: c64,
+    /// `∂G/∂n_x`.
+    pub dg_dnx: c64,
+    /// `G'(r)/r`: `∂G/∂n_y = G'(r)/r (d·n_y)`.
+    gp_over_r: c64,
+    /// `e^{ikr}(1 − ikr)/(4πr³)`.
+    c1: c64,
+    /// `e^{ikr}(3 − 3ikr − k²r²)(d·n_x)/(4πr⁵)`.
+    c2: c64,
+    d: [f64; 3],
+    nx: [f64; 3],
+}
+
+impl PointKernel {
+    /// The kernels at wavenumber `k` between `x` (normal `nx`) and `y ≠ x`.
+    #[inline]
+    pub fn new(k: f64, x: [f64; 3], nx: [f64; 3], y: [f64; 3]) -> PointKernel {
+        let d = sub(y, x);
+        let r2 = dot(d, d);
+        let r = r2.sqrt();
+        let kr = k * r;
+        let (s, c) = kr.sin_cos();
+        let g = c64::new(c, s) * (1.0 / (FOUR_PI * r));
+        // G'(r) = e^{ikr}(ikr − 1)/(4πr²).
+        let gp_over_r = g * c64::new(-1.0, kr) / r2;
+        let dnx = dot(d, nx);
+        let g3 = g / r2;
+        PointKernel {
+            g,
+            dg_dnx: -gp_over_r * dnx,
+            gp_over_r,
+            c1: g3 * c64::new(1.0, -kr),
+            c2: g3 * c64::new(3.0 - kr * kr, -3.0 * kr) * (dnx / r2),
+            d,
+            nx,
+        }
+    }
+
+    /// `∂G/∂n_y` (linear in `ny`, which need not be a unit vector).
+    #[inline]
+    pub fn dg_dny(&self, ny: [f64; 3]) -> c64 {
+        self.gp_over_r * dot(self.d, ny)
+    }
+
+    /// `∂²G/∂n_x∂n_y` (linear in `ny`).
+    #[inline]
+    pub fn d2g(&self, ny: [f64; 3]) -> c64 {
+        self.c1 * dot(self.nx, ny) - self.c2 * dot(self.d, ny)
     }
 }
 

@@ -18,7 +18,7 @@
 //! - [`BoundaryMesh`]: panels, inside test;
 //! - [`solve`]: surface pressure for several velocity fields at one frequency;
 //! - [`cluster`]: fewer pressure unknowns where the wavelength allows ([`solve_clustered`]);
-//! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`solve_with_near`]);
+//! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`Discretization`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
 //! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
@@ -29,6 +29,7 @@
 
 #![warn(missing_docs)]
 
+pub mod assembly;
 pub mod bem;
 pub mod cluster;
 mod error;
@@ -43,7 +44,7 @@ pub mod normals;
 pub mod quadrature;
 pub mod special;
 
-pub use bem::{solve, solve_clustered, solve_with_near, Air, Formulation, SurfaceField};
+pub use bem::{solve, solve_clustered, solve_on, Air, Discretization, Formulation, SurfaceField};
 pub use cluster::{Adjacency, Clusters};
 pub use error::RadiationError;
 /// Complex f64 (`num_complex::Complex<f64>`), the amplitude type of every field.

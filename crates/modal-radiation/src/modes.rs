@@ -18,7 +18,7 @@ use std::time::Instant;
 use faer::c64;
 use modal_bank::ModeBank;
 
-use crate::bem::{solve_with_near, Air, Formulation, SurfaceField};
+use crate::bem::{solve_on, Air, Discretization, Formulation, SurfaceField};
 use crate::cluster::{Adjacency, Clusters};
 use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
@@ -481,7 +481,9 @@ pub fn radiate_modes_on(
         let fresh = plan.level.near.get().is_none();
         let near = plan.level.near.get_or_init(|| NearField::new(mesh));
         let near_s = if fresh { t0.elapsed().as_secs_f64() } else { 0.0 };
-        let surfaces = solve_with_near(mesh, near, &plan.clusters, opts.air, f, &fields, opts.formulation)?;
+        let disc =
+            Discretization { mesh, near, clusters: &plan.clusters, aggregate: opts.adaptive_resolution };
+        let surfaces = solve_on(&disc, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
