@@ -138,25 +138,40 @@ fn median_max(errs: &[(usize, Vec<(f64, f64)>)], within_db: f64) -> (f64, f64, u
     (all[all.len() / 2], all[all.len() - 1], all.len())
 }
 
-/// Our pressures at the reference's points for the given modes.
-fn ours(bank: &ModeBank, reference: &Reference, modes: &[usize]) -> Vec<(usize, Vec<c64>)> {
-    let results =
-        radiate_modes(bank, modes, &RadiationOptions::default(), &mut |p| eprintln!("{p}")).unwrap();
-    modes
+/// Our pressures at the reference's points for the given modes, and the
+/// modes whose solve the solver flagged under-resolved
+/// (`Progress::under_resolved`: its clusters had to grow past `κ` to fit the
+/// dense-size cap, or its panels are coarse for the frequency).
+fn ours(bank: &ModeBank, reference: &Reference, modes: &[usize]) -> (Vec<(usize, Vec<c64>)>, Vec<usize>) {
+    let mut flagged = Vec::new();
+    let results = radiate_modes(bank, modes, &RadiationOptions::default(), &mut |p| {
+        eprintln!("{p}");
+        if p.under_resolved {
+            flagged.extend_from_slice(&p.modes);
+        }
+    })
+    .unwrap();
+    let pressures = modes
         .iter()
         .map(|&i| {
             let r = results.iter().find(|r| r.mode == i).unwrap();
             (i, reference.points.iter().map(|&x| r.pressure_at(x).unwrap()).collect())
         })
-        .collect()
+        .collect();
+    (pressures, flagged)
 }
 
 /// Cross-checks a committed bank against its committed reference, for the
 /// modes `only` (all of the reference's if `None`): checks that the
 /// reference belongs to the bank and its points are ≥ 2 bounding radii
-/// away, prints the errors per mode and returns the counted modes' errors
-/// and the modes left out (> 40 dB below the loudest).
-fn cross_check(bank_file: &str, reference_file: &str, only: Option<&[usize]>) -> (ModeErrors, Vec<usize>) {
+/// away, prints the errors per mode and returns the counted modes' errors,
+/// the modes left out (> 40 dB below the loudest) and the modes our solver
+/// flagged under-resolved.
+fn cross_check(
+    bank_file: &str,
+    reference_file: &str,
+    only: Option<&[usize]>,
+) -> (ModeErrors, Vec<usize>, Vec<usize>) {
     let bank = ModeBank::load(data(bank_file)).unwrap();
     let reference = read_reference(&data(reference_file));
     let c = bank.mass.center_of_mass_m;
@@ -170,80 +185,74 @@ fn cross_check(bank_file: &str, reference_file: &str, only: Option<&[usize]>) ->
         Some(only) => only.to_vec(),
         None => reference.modes.iter().map(|m| m.index).collect(),
     };
-    let got = ours(&bank, &reference, &modes);
+    let (got, flagged) = ours(&bank, &reference, &modes);
     let (errs, left_out) = level_errors(&reference, &got, 40.0);
     for (i, e) in &errs {
         let (md, mx, n) = median_max(&[(*i, e.clone())], 40.0);
-        eprintln!("{bank_file} mode {i}: median {md:.3} dB, max {mx:.3} dB over {n} points");
+        let note = if flagged.contains(i) { " (flagged under-resolved)" } else { "" };
+        eprintln!("{bank_file} mode {i}: median {md:.3} dB, max {mx:.3} dB over {n} points{note}");
     }
     let (median, max, n) = median_max(&errs, 40.0);
     eprintln!(
         "{bank_file}, all counted modes: median {median:.3} dB, max {max:.3} dB over {n} mode-points; \
-         left out (> 40 dB down): {left_out:?}"
+         left out (> 40 dB down): {left_out:?}; flagged under-resolved: {flagged:?}"
     );
-    (errs, left_out)
+    (errs, left_out, flagged)
 }
 
-/// The issue's criterion on the counted modes, at the points within
-/// `points_within_db` of their mode's loudest (the issue's: 40 dB).
-fn assert_within_criterion(errs: &[(usize, Vec<(f64, f64)>)], points_within_db: f64) {
-    let (median, max, n) = median_max(errs, points_within_db);
+/// The issue's criterion: median ≤ 1 dB and max ≤ 3 dB over the counted
+/// modes' points within 40 dB of their mode's loudest.
+fn assert_criterion(errs: &[(usize, Vec<(f64, f64)>)]) {
+    let (median, max, n) = median_max(errs, 40.0);
     assert!(median <= 1.0 && max <= 3.0, "median {median:.3} dB, max {max:.3} dB over {n} mode-points");
-}
-
-/// What the bowls meet (see their tests): the median criterion at every point
-/// within the issue's 40 dB, the whole criterion within 30 dB.
-fn assert_bowl_criterion(errs: &[(usize, Vec<(f64, f64)>)]) {
-    let (median, _, _) = median_max(errs, 40.0);
-    assert!(median <= 1.0, "median {median:.3} dB within 40 dB");
-    assert_within_criterion(errs, 30.0);
 }
 
 #[test]
 fn demo_bar_modes_agree_with_the_bempp_reference() {
-    let (errs, left_out) = cross_check("bar8.bank", "bar8_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bar8.bank", "bar8_bempp.json", None);
     assert!(errs.len() >= 6, "at least six modes counted: {left_out:?} left out");
-    assert_within_criterion(&errs, 40.0);
+    assert_criterion(&errs);
 }
 
 /// The bowl's lowest pair (1143 Hz), in the default suite (a few seconds).
 #[test]
 fn demo_bowl_lowest_pair_agrees_with_the_bempp_reference() {
-    let (errs, _) = cross_check("bowl60.bank", "bowl60_bempp.json", Some(&[0]));
+    let (errs, _, _) = cross_check("bowl60.bank", "bowl60_bempp.json", Some(&[0]));
     assert_eq!(errs.len(), 1);
-    assert_within_criterion(&errs, 40.0);
+    assert_criterion(&errs);
 }
 
-/// The bowl's four lowest pairs, 1.1–8.1 kHz (about 3 min in the test
-/// profile on 2 loaded cores):
+/// The bowl's four lowest pairs, 1.1–8.1 kHz (about 1.5 min in the
+/// release profile on 2 loaded cores):
 /// `cargo test -p modal-radiation --test bempp_reference -- --ignored demo_bowl_modes --nocapture`.
 ///
-/// The issue's criterion holds here for the points within 30 dB of each
-/// mode's loudest, not within 40 dB: measured 2026-11-26, median 0.47 dB
-/// over all 61 counted mode-points, max 2.41 dB within 30 dB, but 3.98 dB
-/// at one point 32.3 dB below the loudest of the 5.3 kHz mode (20° off the
-/// axis under the bowl, close to that mode's axial null). How far the
-/// refine-0 reference itself is converged there is in docs/radiation.md;
-/// with `--cluster-kh 0.25` ours comes within 2.02 dB of it there.
+/// Measured 2026-11-26 at the default `κ` = 0.3: median 0.322 dB, max
+/// 1.773 dB (the 3.0 kHz pair at a point 24.8 dB below its loudest) over 61
+/// mode-points; per pair max 0.757 / 1.773 / 1.027 / 1.261 dB. The 5.3 and
+/// 8.1 kHz pairs ask for more unknowns than the dense-size cap
+/// (`MAX_DENSE_PANELS`), so their clusters are grown until they fit and the
+/// solve says "under-resolved"; at a point 33 dB down their error depends
+/// on where the grown clusters' boundaries fall (with the cap lifted to
+/// 14 000: 1.08 / 1.26 dB). At the former `κ` = 0.5: max 3.98 dB.
 #[test]
 #[ignore = "about 3 min: the bowl's four lowest pairs"]
 fn demo_bowl_modes_agree_with_the_bempp_reference() {
-    let (errs, left_out) = cross_check("bowl60.bank", "bowl60_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bowl60.bank", "bowl60_bempp.json", None);
     assert!(errs.len() == 4, "all four pairs counted: {left_out:?} left out");
-    assert_bowl_criterion(&errs);
+    assert_criterion(&errs);
 }
 
 /// The small bowl against a reference converged across its 4 mm wall.
-/// Measured 2026-11-26: median 0.35 / 0.27 dB per mode, max 1.08 dB at
-/// 4.6 kHz, but 4.09 dB at 11.4 kHz at a point 36 dB below that mode's
-/// loudest; within 30 dB of each mode's loudest the max is 1.17 dB. With
-/// finer pressure clusters (`--cluster-kh 0.25`) that point comes to
-/// 1.19 dB: the default clusters, not the reference, set the error there.
+/// Measured 2026-11-26 at the default `κ` = 0.3: median 0.036 / 0.093 dB,
+/// max 0.600 / 1.173 dB at 4.6 / 11.4 kHz. At the former `κ` = 0.5 the
+/// 11.4 kHz mode was 4.01 dB off at a point 36 dB below its loudest; one
+/// unknown per panel (`--full-resolution`) gives 1.99 dB there: that much is
+/// the panels' own error (k·h = 0.81), the rest was the clusters'.
 #[test]
 fn small_bowl_agrees_with_a_converged_bempp_reference() {
-    let (errs, left_out) = cross_check("bowl30.bank", "bowl30_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bowl30.bank", "bowl30_bempp.json", None);
     assert!(errs.len() == 2, "both pairs counted: {left_out:?} left out");
-    assert_bowl_criterion(&errs);
+    assert_criterion(&errs);
 }
 
 /// Re-runs the references (needs the Python packages of `tools/rad_ref.py`;
