@@ -42,6 +42,13 @@
 //!   converged across the wall (docs/radiation.md, "Cross-check against
 //!   bempp-cl": refine 0 to 1 moves it by ≤ 0.9 dB, quadrature order 4 to 8
 //!   by ≤ 4e-5 of the pressure).
+//! - `twobars.bank`, **two parts**: two parallel steel bars (150 × 20 × 12 mm
+//!   and 120 × 20 × 12 mm, 10 mm apart; `twobars.obj`, 24 lines), `modal
+//!   precompute twobars.obj --material steel --modes 10 --cell 0.006
+//!   --accuracy off --no-cache -o twobars.bank` (2.7–13.5 kHz; each mode
+//!   moves one bar, the other scatters its sound), and `twobars_bempp.json`:
+//!   all 10 modes at refine 1 (5 984 flat triangles, 2 996 P1 unknowns;
+//!   80 min on 2 loaded cores).
 
 use std::path::{Path, PathBuf};
 
@@ -255,14 +262,40 @@ fn small_bowl_agrees_with_a_converged_bempp_reference() {
     assert_criterion(&errs);
 }
 
+/// A two-part object (two parallel bars 10 mm apart), its two lowest modes
+/// in the default suite.
+#[test]
+fn two_bars_lowest_modes_agree_with_the_bempp_reference() {
+    let (errs, _, _) = cross_check("twobars.bank", "twobars_bempp.json", Some(&[0, 1]));
+    assert_eq!(errs.len(), 2);
+    assert_criterion(&errs);
+}
+
+/// Every mode of the two-part object, 2.7–13.5 kHz (about 1.5 min in the
+/// release profile):
+/// `cargo test -p modal-radiation --test bempp_reference -- --ignored two_bars_every --nocapture`.
+///
+/// Measured 2026-11-26 at the default `κ` = 0.3 (this test, release
+/// profile, 85 s): all 10 modes within 15 dB of the loudest, median
+/// 0.327 dB, max 1.941 dB (mode 2, 4.4 kHz) over 160 mode-points; per mode max 0.35–0.70 dB except 1.94 (mode 2) and 1.00
+/// (mode 5). Modes 6–9 (≥ 10.8 kHz) are flagged under-resolved (the
+/// bank's 6 mm cell gives panels with k·h > 1) and still within 1 dB.
+#[test]
+#[ignore = "about 1.5 min: ten modes of a two-part object"]
+fn two_bars_every_mode_agrees_with_the_bempp_reference() {
+    let (errs, left_out, _) = cross_check("twobars.bank", "twobars_bempp.json", None);
+    assert!(errs.len() == 10, "all ten modes counted: {left_out:?} left out");
+    assert_criterion(&errs);
+}
+
 /// Re-runs the references (needs the Python packages of `tools/rad_ref.py`;
 /// interpreter from `$MODAL_RAD_REF_PYTHON`, default
 /// `/work/venvs/bempp/bin/python`) and checks each reproduces its committed
 /// file, each mode at its recorded `refine` and `quadrature`:
 /// `cargo test -p modal-radiation --test bempp_reference -- --ignored`
-/// (about 1.5 h on 2 loaded cores: bempp's JIT compile and the dense
+/// (about 3 h on 2 loaded cores: bempp's JIT compile and the dense
 /// solves, 14 min for the bar at refine 0, 13 min for its mode 5 at refine
-/// 1, 5–10 min per mode of either bowl).
+/// 1, 5–10 min per mode of either bowl, 80 min for the two bars).
 #[test]
 #[ignore = "needs bempp-cl (Python); about 1.5 h"]
 fn the_committed_references_are_what_rad_ref_computes() {
@@ -272,6 +305,7 @@ fn the_committed_references_are_what_rad_ref_computes() {
         ("bar8.bank", "bar8_bempp.json"),
         ("bowl60.bank", "bowl60_bempp.json"),
         ("bowl30.bank", "bowl30_bempp.json"),
+        ("twobars.bank", "twobars_bempp.json"),
     ];
     for (bank, file) in objects {
         let text = std::fs::read_to_string(data(file)).unwrap();
