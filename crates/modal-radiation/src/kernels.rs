@@ -468,16 +468,21 @@ mod tests {
     /// Measured (`cargo test -p modal-radiation --lib far_rules -- --nocapture`):
     /// 3-point ≤ 6.8e-4 from 3 diameters on, centroid ≤ 2.0e-2 from 8 on
     /// (at k·d = 1; 3.6e-3 at k·d = 0): the 3-point rule at mid range is
-    /// more accurate than the centroid rule already used farther out.
+    /// more accurate than the centroid rule already used farther out. At
+    /// 1 < k·d ≤ 2 (far panels of the top band, [`crate::assembly::THREE_POINT_MAX_KH`])
+    /// the 3-point rule stays ≤ 6e-3 out to 16 diameters; the adaptive
+    /// rule it is compared with is itself within 2e-5 there (7 points on
+    /// the whole panel against 7 on each of 256 sub-triangles).
     #[test]
     fn far_rules_meet_their_stated_error() {
         use crate::bem::{FAR_POINT_RATIO, MID_POINT_RATIO};
-        for ratio in [MID_POINT_RATIO, 4.0, 5.0, 6.0, FAR_POINT_RATIO] {
-            for kd in [0.0, 0.5, 1.0] {
+        for ratio in [MID_POINT_RATIO, 4.0, 5.0, 6.0, FAR_POINT_RATIO, 16.0] {
+            for kd in [0.0, 0.5, 1.0, 1.5, crate::assembly::THREE_POINT_MAX_KH] {
                 let (e3, e1) = rule_errors(ratio, kd);
                 eprintln!("ratio {ratio} kd {kd}: 3-point {e3:.2e}, centroid {e1:.2e}");
-                assert!(e3 < 1e-3, "3-point rule at {ratio} diameters, k·d = {kd}: {e3}");
-                if ratio >= FAR_POINT_RATIO {
+                let bound = if kd <= 1.0 { 1e-3 } else { 1e-2 };
+                assert!(e3 < bound, "3-point rule at {ratio} diameters, k·d = {kd}: {e3}");
+                if ratio >= FAR_POINT_RATIO && kd <= 1.0 {
                     assert!(e1 < 2.5e-2, "centroid rule at {ratio} diameters, k·d = {kd}: {e1}");
                 }
             }
