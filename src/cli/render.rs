@@ -176,8 +176,9 @@ impl PipelineProvider<'_> {
             (Some(cache), Some(key)) => {
                 // v2: geometry-only near field (modal_radiation::near); v3: node normals
                 // fitted to the surface (modal_radiation::normals); v4: far clusters summed
-                // as points (modal_radiation::assembly).
-                let key = CacheKey::new("modal-radiation-v4")
+                // as points (modal_radiation::assembly); v5: 3-point rule for far panels at
+                // 1 < k·h ≤ 2.
+                let key = CacheKey::new("modal-radiation-v5")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)

@@ -171,17 +171,15 @@ pub(crate) fn solve_to_accuracy(
     let parts = |level: &Level| level.bank.info.rigid_modes_removed;
     if parts(&coarse) != parts(&fine) {
         // Another object (see the module docs): a milder coarsening, if it keeps the parts.
-        if let Ok(mild) = solve_level(&wide, 1, base_cell, MILD_COARSE_FACTOR, key, progress) {
-            spent += mild.seconds;
-            if parts(&mild) == parts(&fine) {
-                coarse = mild;
-            } else {
-                warnings.push(format!(
-                    "the coarser levels of the error estimate (element sizes × {COARSE_FACTOR} and × \
-                     {MILD_COARSE_FACTOR:.2}) split or join parts of the mesh: the estimate compares different \
-                     objects and is only a rough bound"
-                ));
+        match solve_level(&wide, 1, base_cell, MILD_COARSE_FACTOR, key, progress) {
+            Ok(mild) => {
+                spent += mild.seconds;
+                match mild_outcome(parts(&fine), Ok(parts(&mild))) {
+                    None => coarse = mild,
+                    Some(warning) => warnings.push(warning),
+                }
             }
+            Err(err) => warnings.extend(mild_outcome(parts(&fine), Err(err.to_string()))),
         }
     }
     let prescribed = request.surface.cell.is_some();
@@ -244,6 +242,25 @@ pub(crate) fn solve_to_accuracy(
         }
     }
     unreachable!("the loop returns")
+}
+
+/// Whether the milder coarse level replaces a coarse level that changed the part count:
+/// `None` when it was solved (`mild_parts` Ok) with the fine level's `fine_parts`, else
+/// the warning that the estimate compares different objects (the milder level also
+/// changed the parts, or failed: the reason is said either way, never dropped).
+fn mild_outcome(fine_parts: usize, mild_parts: Result<usize, String>) -> Option<String> {
+    let why = match mild_parts {
+        Ok(parts) if parts == fine_parts => return None,
+        Ok(_) => format!("element sizes × {COARSE_FACTOR} and × {MILD_COARSE_FACTOR:.2} both split or join parts of the mesh"),
+        Err(err) => format!(
+            "element sizes × {COARSE_FACTOR} split or join parts of the mesh, and the milder × \
+             {MILD_COARSE_FACTOR:.2} failed: {err}"
+        ),
+    };
+    Some(format!(
+        "the coarser levels of the error estimate do not keep the object ({why}): the estimate compares \
+         different objects and is only a rough bound"
+    ))
 }
 
 /// Why a refinement is not started.
@@ -336,6 +353,15 @@ fn memory_guard_bytes() -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_milder_coarse_level_replaces_only_when_it_keeps_the_parts_and_a_failure_is_said() {
+        assert_eq!(mild_outcome(2, Ok(2)), None);
+        let joined = mild_outcome(2, Ok(1)).expect("parts changed again: a warning");
+        assert!(joined.contains("both split or join") && joined.contains("rough bound"), "{joined}");
+        let failed = mild_outcome(2, Err("the mesher refused".into())).expect("a failure: a warning");
+        assert!(failed.contains("failed: the mesher refused") && failed.contains("rough bound"), "{failed}");
+    }
 
     #[test]
     fn refinement_stops_for_memory_then_time_then_count() {
