@@ -148,12 +148,185 @@ fn integrals(
     }
 }
 
-/// The system at wavenumber `k` with Burton–Miller coupling `alpha`, for
-/// the panel densities `q` (one field per entry, `q_j = iωρ₀ v_j`). Row
-/// `i` (cluster `i`) of `A` is stored as column `i` of the returned `at`
-/// (column-major `n × n`, i.e. `at = Aᵀ`); the right-hand sides come back
-/// row-major `n × nrhs`. `aggregate` allows the far cluster sums (module
-/// doc); off, every panel is integrated on its own.
+/// The operators of one solve: the geometry, the kernels at one wavenumber,
+/// the velocity fields, and per cluster its region and velocity moments.
+/// Gives the system's entries and each source cluster's part of the
+/// right-hand sides, for any rows and source clusters ([`Assembly::row`]):
+/// all of them (the dense assembly) or blocks ([`crate::hmatrix`]).
+pub(crate) struct Assembly<'a> {
+    mesh: &'a BoundaryMesh,
+    near_field: &'a NearField,
+    kern: &'a Kernels,
+    alpha: c64,
+    q: &'a [Vec<c64>],
+    aggregate: bool,
+    regions: Vec<Region>,
+    moments: Vec<Vec<Moments>>,
+}
+
+impl<'a> Assembly<'a> {
+    /// The system at wavenumber `kern.k()` with Burton–Miller coupling
+    /// `alpha` for the panel densities `q` (one field per entry,
+    /// `q_j = iωρ₀ v_j`); `aggregate` allows the far cluster sums (module
+    /// doc), off every panel is integrated on its own.
+    pub(crate) fn new(
+        mesh: &'a BoundaryMesh,
+        near_field: &'a NearField,
+        clusters: &Clusters,
+        kern: &'a Kernels,
+        alpha: c64,
+        q: &'a [Vec<c64>],
+        aggregate: bool,
+    ) -> Assembly<'a> {
+        let zero = c64::new(0.0, 0.0);
+        let regions = regions(mesh, clusters);
+        let moments = regions
+            .iter()
+            .map(|src| {
+                q.iter()
+                    .map(|qf| {
+                        let mut m = Moments { q: zero, d_re: [0.0; 3], d_im: [0.0; 3] };
+                        for &(j, _) in &src.members {
+                            let p = &mesh.panels[j];
+                            let aq = qf[j] * p.area;
+                            let d = sub(p.centroid, src.centre);
+                            m.q += aq;
+                            for ((re, im), dc) in m.d_re.iter_mut().zip(&mut m.d_im).zip(d) {
+                                *re += aq.re * dc;
+                                *im += aq.im * dc;
+                            }
+                        }
+                        m
+                    })
+                    .collect()
+            })
+            .collect();
+        Assembly { mesh, near_field, kern, alpha, q, aggregate, regions, moments }
+    }
+
+    /// Number of unknowns (clusters).
+    pub(crate) fn len(&self) -> usize {
+        self.regions.len()
+    }
+
+    /// The velocity fields `q`.
+    pub(crate) fn fields(&self) -> &[Vec<c64>] {
+        self.q
+    }
+
+    /// Centre of cluster `c` and the box of its panels' corners (low, high).
+    pub(crate) fn bounds(&self, c: usize) -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for &(j, _) in &self.regions[c].members {
+            for v in self.mesh.panels[j].corners.map(|i| self.mesh.vertices[i]) {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(v[k]);
+                    hi[k] = hi[k].max(v[k]);
+                }
+            }
+        }
+        (self.regions[c].centre, lo, hi)
+    }
+
+    /// Row `i` of `A` over the source clusters `sources`, written into `row`
+    /// (one entry per source), and each source's part of the right-hand sides,
+    /// `R_f(i, c) = Σ_{j∈c} op_ij q_fj`, into `b` (row-major, one row of
+    /// `nrhs` per source: `b_i = Σ_c R(i, c)`). Far source clusters are
+    /// summed as points when `aggregate` (module doc).
+    pub(crate) fn row(&self, i: usize, sources: &[usize], row: &mut [c64], b: &mut [c64]) {
+        let (k, alpha) = (self.kern.k(), self.alpha);
+        let region = &self.regions[i];
+        let nrhs = self.q.len().max(1);
+        for ((slot, &c), b) in row.iter_mut().zip(sources).zip(b.chunks_mut(nrhs)) {
+            *slot = c64::new(0.0, 0.0);
+            b.fill(c64::new(0.0, 0.0));
+            let src = &self.regions[c];
+            let r = norm(sub(src.centre, region.centre));
+            let clear = r - src.radius;
+            let far_cluster = self.aggregate
+                && k * src.radius <= 1.0
+                && r > AGGREGATE_RATIO * src.radius
+                && clear >= CLUSTER_NEAR_RATIO * (region.radius + src.max_diameter)
+                && clear >= region.radius + MID_POINT_RATIO * src.max_diameter;
+            if far_cluster {
+                let pk = PointKernel::new(k, region.centre, region.normal, src.centre);
+                *slot -= pk.dg_dny(src.normal_sum) + alpha * pk.d2g(src.normal_sum);
+                let f_mono = pk.g + alpha * pk.dg_dnx;
+                for (bf, m) in b.iter_mut().zip(&self.moments[c]) {
+                    let dipole = |d: [f64; 3]| pk.dg_dny(d) + alpha * pk.d2g(d);
+                    *bf -= f_mono * m.q + dipole(m.d_re) + c64::new(0.0, 1.0) * dipole(m.d_im);
+                }
+                continue;
+            }
+            for &(j, _) in &src.members {
+                let (a, op) = self.pair(i, j);
+                *slot += a;
+                for (bf, qf) in b.iter_mut().zip(self.q) {
+                    *bf += op * qf[j];
+                }
+            }
+        }
+    }
+
+    /// Panel `j`'s weights in row `i`, integrated on its own: its term of
+    /// `A_ic` (`c` its cluster) and its factor `op` in `b_i += op·q_j`.
+    fn pair(&self, i: usize, j: usize) -> (c64, c64) {
+        let (kern, mesh, alpha) = (self.kern, self.mesh, self.alpha);
+        let zero = c64::new(0.0, 0.0);
+        let region = &self.regions[i];
+        let pj = &mesh.panels[j];
+        let dist = norm(sub(pj.centroid, region.centre));
+        let near = region.members.len() == 1
+            || dist < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter)
+            || dist < region.radius + MID_POINT_RATIO * pj.diameter;
+        if !near {
+            let ints = integrals(kern, mesh, pj, region.centre, region.normal);
+            return (-ints.dg_dny - alpha * ints.d2g, -(ints.g + alpha * ints.dg_dnx));
+        }
+        let (mut a, mut op) = (zero, zero);
+        for &(t, w) in &region.members {
+            let pt = &mesh.panels[t];
+            let (panels, statics) = self.near_field.row(t);
+            let ints = if t == j {
+                kern.self_integrals(mesh, pj)
+            } else if let Ok(s) = panels.binary_search(&(j as u32)) {
+                kern.near(mesh, pj, pt.centroid, pt.normal, &statics[s])
+            } else {
+                integrals(kern, mesh, pj, pt.centroid, pt.normal)
+            };
+            let half = if t == j { 0.5 } else { 0.0 };
+            a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
+            // −(L + α(½ + K')) q_j
+            op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
+        }
+        (a, op)
+    }
+}
+
+/// The dense system of an [`Assembly`]: row `i` (cluster `i`) of `A` is
+/// stored as column `i` of the returned `at` (column-major `n × n`, i.e.
+/// `at = Aᵀ`); the right-hand sides come back row-major `n × nrhs`.
+pub(crate) fn assemble_dense(asm: &Assembly<'_>) -> (Vec<c64>, Vec<c64>) {
+    let n = asm.len();
+    let nrhs = asm.q.len();
+    let zero = c64::new(0.0, 0.0);
+    let sources: Vec<usize> = (0..n).collect();
+    let mut at = vec![zero; n * n];
+    let mut rhs = vec![zero; n * nrhs];
+    at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
+        let mut parts = vec![zero; n * nrhs];
+        asm.row(i, &sources, row, &mut parts);
+        for part in parts.chunks(nrhs.max(1)) {
+            for (bf, p) in b.iter_mut().zip(part) {
+                *bf += p;
+            }
+        }
+    });
+    (at, rhs)
+}
+
+/// [`assemble_dense`] of a new [`Assembly`].
+#[cfg(test)]
 pub(crate) fn assemble(
     mesh: &BoundaryMesh,
     near_field: &NearField,
@@ -163,89 +336,5 @@ pub(crate) fn assemble(
     q: &[Vec<c64>],
     aggregate: bool,
 ) -> (Vec<c64>, Vec<c64>) {
-    let n = clusters.len();
-    let nrhs = q.len();
-    let k = kern.k();
-    let zero = c64::new(0.0, 0.0);
-    let regions = regions(mesh, clusters);
-    let moments: Vec<Vec<Moments>> = regions
-        .iter()
-        .map(|src| {
-            q.iter()
-                .map(|qf| {
-                    let mut m = Moments { q: zero, d_re: [0.0; 3], d_im: [0.0; 3] };
-                    for &(j, _) in &src.members {
-                        let p = &mesh.panels[j];
-                        let aq = qf[j] * p.area;
-                        let d = sub(p.centroid, src.centre);
-                        m.q += aq;
-                        for ((re, im), dc) in m.d_re.iter_mut().zip(&mut m.d_im).zip(d) {
-                            *re += aq.re * dc;
-                            *im += aq.im * dc;
-                        }
-                    }
-                    m
-                })
-                .collect()
-        })
-        .collect();
-    let mut at = vec![zero; n * n];
-    let mut rhs = vec![zero; n * nrhs];
-    at.par_chunks_mut(n).zip(rhs.par_chunks_mut(nrhs.max(1))).enumerate().for_each(|(i, (row, b))| {
-        let region = &regions[i];
-        let single = region.members.len() == 1;
-        let rows: Vec<_> = region.members.iter().map(|&(t, _)| near_field.row(t)).collect();
-        for (c, src) in regions.iter().enumerate() {
-            let r = norm(sub(src.centre, region.centre));
-            let clear = r - src.radius;
-            let far_cluster = aggregate
-                && k * src.radius <= 1.0
-                && r > AGGREGATE_RATIO * src.radius
-                && clear >= CLUSTER_NEAR_RATIO * (region.radius + src.max_diameter)
-                && clear >= region.radius + MID_POINT_RATIO * src.max_diameter;
-            if far_cluster {
-                let pk = PointKernel::new(k, region.centre, region.normal, src.centre);
-                row[c] -= pk.dg_dny(src.normal_sum) + alpha * pk.d2g(src.normal_sum);
-                let f_mono = pk.g + alpha * pk.dg_dnx;
-                for (bf, m) in b.iter_mut().zip(&moments[c]) {
-                    let dipole = |d: [f64; 3]| pk.dg_dny(d) + alpha * pk.d2g(d);
-                    *bf -= f_mono * m.q + dipole(m.d_re) + c64::new(0.0, 1.0) * dipole(m.d_im);
-                }
-                continue;
-            }
-            for &(j, _) in &src.members {
-                let pj = &mesh.panels[j];
-                let dist = norm(sub(pj.centroid, region.centre));
-                let near = single
-                    || dist < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter)
-                    || dist < region.radius + MID_POINT_RATIO * pj.diameter;
-                let (mut a, mut op) = (zero, zero);
-                if near {
-                    for (&(t, w), &(panels, statics)) in region.members.iter().zip(&rows) {
-                        let pt = &mesh.panels[t];
-                        let ints = if t == j {
-                            kern.self_integrals(mesh, pj)
-                        } else if let Ok(s) = panels.binary_search(&(j as u32)) {
-                            kern.near(mesh, pj, pt.centroid, pt.normal, &statics[s])
-                        } else {
-                            integrals(kern, mesh, pj, pt.centroid, pt.normal)
-                        };
-                        let half = if t == j { 0.5 } else { 0.0 };
-                        a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
-                        // −(L + α(½ + K')) q_j
-                        op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
-                    }
-                } else {
-                    let ints = integrals(kern, mesh, pj, region.centre, region.normal);
-                    a = -ints.dg_dny - alpha * ints.d2g;
-                    op = -(ints.g + alpha * ints.dg_dnx);
-                }
-                row[c] += a;
-                for (bf, qf) in b.iter_mut().zip(q) {
-                    *bf += op * qf[j];
-                }
-            }
-        }
-    });
-    (at, rhs)
+    assemble_dense(&Assembly::new(mesh, near_field, clusters, kern, alpha, q, aggregate))
 }

@@ -1,4 +1,5 @@
-//! Restarted GMRES for the dense Burton–Miller system `A x = b`.
+//! Restarted GMRES for the Burton–Miller system `A x = b`, dense or
+//! compressed ([`solve_with`] takes any product `x ↦ A x`).
 //!
 //! GMRES(m) minimises `‖b − A x‖₂` over `x₀ + K_m(A, r₀)`,
 //! `K_m = span{r₀, A r₀, …, A^{m−1} r₀}`: Arnoldi with modified
@@ -67,8 +68,17 @@ pub struct Solution {
 pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
     let n = b.len();
     debug_assert_eq!(a.len(), n * n);
+    let diagonal: Vec<c64> = (0..n).map(|i| a[i * n + i]).collect();
+    solve_with(&diagonal, &|x: &[c64], y: &mut [c64]| product(a, x, y), b)
+}
+
+/// [`solve`] for an operator given by its diagonal and its product
+/// `apply(x, y)`: `y = A x` (for instance a compressed matrix,
+/// [`crate::hmatrix`]); `apply` must be deterministic for the result to be.
+pub fn solve_with(diagonal: &[c64], apply: &dyn Fn(&[c64], &mut [c64]), b: &[c64]) -> Option<Solution> {
+    let n = b.len();
     let zero = c64::new(0.0, 0.0);
-    let inv_diag: Vec<c64> = (0..n).map(|i| 1.0 / a[i * n + i]).collect();
+    let inv_diag: Vec<c64> = diagonal.iter().map(|d| 1.0 / d).collect();
     if inv_diag.iter().any(|d| !(d.re.is_finite() && d.im.is_finite())) {
         return None;
     }
@@ -99,7 +109,7 @@ pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
                 *s = vj * d;
             }
             let mut w = vec![zero; n];
-            product(a, &scratch, &mut w);
+            apply(&scratch, &mut w);
             for (i, vi) in v.iter().enumerate() {
                 let hij = dot(vi, &w);
                 h[i][j] = hij;
@@ -151,7 +161,7 @@ pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
             *s = ui * d;
         }
         let mut au = vec![zero; n];
-        product(a, &scratch, &mut au);
+        apply(&scratch, &mut au);
         for (ri, (bi, ai)) in r.iter_mut().zip(b.iter().zip(&au)) {
             *ri = bi - ai;
         }

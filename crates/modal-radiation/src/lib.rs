@@ -18,6 +18,7 @@
 //! - [`BoundaryMesh`]: panels, inside test;
 //! - [`solve`]: surface pressure for several velocity fields at one frequency;
 //! - [`cluster`]: fewer pressure unknowns where the wavelength allows ([`solve_clustered`]);
+//! - [`hmatrix`]: the system compressed (far blocks low rank by ACA) for large solves;
 //! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`Discretization`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
@@ -35,6 +36,7 @@ pub mod cluster;
 mod error;
 pub mod geometry;
 pub mod gmres;
+pub mod hmatrix;
 pub mod kernels;
 pub mod mfs;
 pub mod modes;
