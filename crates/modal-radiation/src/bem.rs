@@ -340,9 +340,7 @@ mod tests {
     #[test]
     fn far_clusters_summed_as_points_match_panel_by_panel() {
         use crate::cluster::Adjacency;
-        let (v, t) = modal_mesh::icosphere(4);
-        let verts = v.iter().map(|p| [0.1 * p[0], 0.06 * p[1], 0.04 * p[2]]).collect();
-        let mesh = BoundaryMesh::new(verts, &t).unwrap();
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 4);
         let near = NearField::new(&mesh);
         // A bending-like field: sign changes along x and z.
         let vel: Vec<c64> = mesh
@@ -378,9 +376,7 @@ mod tests {
     #[test]
     fn gmres_and_lu_agree_on_a_burton_miller_system() {
         // 1280 panels (above ITERATIVE_MIN_UNKNOWNS), an ellipsoid, ka ≈ 2.
-        let (v, t) = modal_mesh::icosphere(3);
-        let verts = v.iter().map(|p| [0.1 * p[0], 0.07 * p[1], 0.05 * p[2]]).collect();
-        let mesh = BoundaryMesh::new(verts, &t).unwrap();
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.07, 0.05], 3);
         let n = mesh.len();
         assert!(n >= ITERATIVE_MIN_UNKNOWNS);
         let vel: Vec<c64> =

@@ -163,6 +163,15 @@ pub(crate) mod tests {
         BoundaryMesh::new(v, &t).unwrap()
     }
 
+    /// Ellipsoid with semi-axes `axes` [m] about the origin: the unit
+    /// icosphere of `subdiv` subdivisions scaled along x, y and z (the
+    /// non-spherical test surface of the solver's unit tests).
+    pub fn ellipsoid(axes: [f64; 3], subdiv: u32) -> BoundaryMesh {
+        let (v, t) = modal_mesh::icosphere(subdiv);
+        let v = v.iter().map(|p| [0, 1, 2].map(|k| axes[k] * p[k])).collect();
+        BoundaryMesh::new(v, &t).unwrap()
+    }
+
     #[test]
     fn sphere_area_normals_and_inside_test() {
         let m = icosphere(0.5, [1.0, 0.0, 0.0], 3);

@@ -566,7 +566,6 @@ mod tests {
 mod system_tests {
     use super::*;
     use crate::cluster::{Adjacency, Clusters};
-    use crate::geometry::BoundaryMesh;
     use crate::kernels::Kernels;
     use crate::near::NearField;
 
@@ -578,9 +577,7 @@ mod system_tests {
     /// within 1e-8, right-hand sides within 1e-7.
     #[test]
     fn compressed_system_matches_the_dense_one() {
-        let (v, t) = modal_mesh::icosphere(3);
-        let verts = v.iter().map(|p| [0.1 * p[0], 0.06 * p[1], 0.04 * p[2]]).collect();
-        let mesh = BoundaryMesh::new(verts, &t).unwrap();
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 3);
         let near = NearField::new(&mesh);
         let k = 2.0 * std::f64::consts::PI * 6000.0 / 343.0;
         let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), 0.6 / k);

@@ -136,9 +136,7 @@ mod tests {
     #[test]
     fn near_pairs_are_exactly_those_within_the_ratio() {
         // A thin slab: both faces within reach of each other.
-        let (v, t) = modal_mesh::icosphere(3);
-        let verts = v.iter().map(|p| [0.1 * p[0], 0.1 * p[1], 0.004 * p[2]]).collect();
-        let mesh = BoundaryMesh::new(verts, &t).unwrap();
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.1, 0.004], 3);
         let near = NearField::new(&mesh);
         let mut pairs = 0;
         for t in 0..mesh.len() {
