@@ -177,8 +177,8 @@ impl PipelineProvider<'_> {
                 // v2: geometry-only near field (modal_radiation::near); v3: node normals
                 // fitted to the surface (modal_radiation::normals); v4: far clusters summed
                 // as points (modal_radiation::assembly); v5: 3-point rule for far panels at
-                // 1 < k·h ≤ 2.
-                let key = CacheKey::new("modal-radiation-v5")
+                // 1 < k·h ≤ 2; v6: default pressure clusters κ = 0.3 (was 0.5).
+                let key = CacheKey::new("modal-radiation-v6")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)

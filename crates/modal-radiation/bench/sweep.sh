@@ -11,7 +11,7 @@ cd "${1:-.}"
 P=$(awk 'BEGIN { for (i = 0; i < 12; i++) { t = 0.15 + 0.25 * i; f = 1.1 * i;
   printf "--point %.6f,%.6f,%.6f ", 0.15 + 0.3 * sin(t) * cos(f), 0.01 + 0.3 * sin(t) * sin(f), 0.006 + 0.3 * cos(t) } }')
 M="--mode 0 --mode 1 --mode 2 --mode 3 --mode 4 --mode 8"
-for k in 2 1 0.5 0.35; do
+for k in 2 1 0.5 0.35 0.3; do
   /usr/bin/time -f "%e s %M KB" modal radiation bar.bank $M $P --cluster-kh $k --json > bar_k$k.json 2> bar_k$k.err
 done
 /usr/bin/time -f "%e s %M KB" modal radiation bar.bank $M $P --full-resolution --json > bar_full.json 2> bar_full.err

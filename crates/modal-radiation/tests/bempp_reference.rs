@@ -42,6 +42,13 @@
 //!   converged across the wall (docs/radiation.md, "Cross-check against
 //!   bempp-cl": refine 0 to 1 moves it by ≤ 0.9 dB, quadrature order 4 to 8
 //!   by ≤ 4e-5 of the pressure).
+//! - `twobars.bank`, **two parts**: two parallel steel bars (150 × 20 × 12 mm
+//!   and 120 × 20 × 12 mm, 10 mm apart; `twobars.obj`, 24 lines), `modal
+//!   precompute twobars.obj --material steel --modes 10 --cell 0.006
+//!   --accuracy off --no-cache -o twobars.bank` (2.7–13.5 kHz; each mode
+//!   moves one bar, the other scatters its sound), and `twobars_bempp.json`:
+//!   all 10 modes at refine 1 (5 984 flat triangles, 2 996 P1 unknowns;
+//!   80 min on 2 loaded cores).
 
 use std::path::{Path, PathBuf};
 
@@ -138,25 +145,40 @@ fn median_max(errs: &[(usize, Vec<(f64, f64)>)], within_db: f64) -> (f64, f64, u
     (all[all.len() / 2], all[all.len() - 1], all.len())
 }
 
-/// Our pressures at the reference's points for the given modes.
-fn ours(bank: &ModeBank, reference: &Reference, modes: &[usize]) -> Vec<(usize, Vec<c64>)> {
-    let results =
-        radiate_modes(bank, modes, &RadiationOptions::default(), &mut |p| eprintln!("{p}")).unwrap();
-    modes
+/// Our pressures at the reference's points for the given modes, and the
+/// modes whose solve the solver flagged under-resolved
+/// (`Progress::under_resolved`: its clusters had to grow past `κ` to fit the
+/// dense-size cap, or its panels are coarse for the frequency).
+fn ours(bank: &ModeBank, reference: &Reference, modes: &[usize]) -> (Vec<(usize, Vec<c64>)>, Vec<usize>) {
+    let mut flagged = Vec::new();
+    let results = radiate_modes(bank, modes, &RadiationOptions::default(), &mut |p| {
+        eprintln!("{p}");
+        if p.under_resolved {
+            flagged.extend_from_slice(&p.modes);
+        }
+    })
+    .unwrap();
+    let pressures = modes
         .iter()
         .map(|&i| {
             let r = results.iter().find(|r| r.mode == i).unwrap();
             (i, reference.points.iter().map(|&x| r.pressure_at(x).unwrap()).collect())
         })
-        .collect()
+        .collect();
+    (pressures, flagged)
 }
 
 /// Cross-checks a committed bank against its committed reference, for the
 /// modes `only` (all of the reference's if `None`): checks that the
 /// reference belongs to the bank and its points are ≥ 2 bounding radii
-/// away, prints the errors per mode and returns the counted modes' errors
-/// and the modes left out (> 40 dB below the loudest).
-fn cross_check(bank_file: &str, reference_file: &str, only: Option<&[usize]>) -> (ModeErrors, Vec<usize>) {
+/// away, prints the errors per mode and returns the counted modes' errors,
+/// the modes left out (> 40 dB below the loudest) and the modes our solver
+/// flagged under-resolved.
+fn cross_check(
+    bank_file: &str,
+    reference_file: &str,
+    only: Option<&[usize]>,
+) -> (ModeErrors, Vec<usize>, Vec<usize>) {
     let bank = ModeBank::load(data(bank_file)).unwrap();
     let reference = read_reference(&data(reference_file));
     let c = bank.mass.center_of_mass_m;
@@ -170,80 +192,100 @@ fn cross_check(bank_file: &str, reference_file: &str, only: Option<&[usize]>) ->
         Some(only) => only.to_vec(),
         None => reference.modes.iter().map(|m| m.index).collect(),
     };
-    let got = ours(&bank, &reference, &modes);
+    let (got, flagged) = ours(&bank, &reference, &modes);
     let (errs, left_out) = level_errors(&reference, &got, 40.0);
     for (i, e) in &errs {
         let (md, mx, n) = median_max(&[(*i, e.clone())], 40.0);
-        eprintln!("{bank_file} mode {i}: median {md:.3} dB, max {mx:.3} dB over {n} points");
+        let note = if flagged.contains(i) { " (flagged under-resolved)" } else { "" };
+        eprintln!("{bank_file} mode {i}: median {md:.3} dB, max {mx:.3} dB over {n} points{note}");
     }
     let (median, max, n) = median_max(&errs, 40.0);
     eprintln!(
         "{bank_file}, all counted modes: median {median:.3} dB, max {max:.3} dB over {n} mode-points; \
-         left out (> 40 dB down): {left_out:?}"
+         left out (> 40 dB down): {left_out:?}; flagged under-resolved: {flagged:?}"
     );
-    (errs, left_out)
+    (errs, left_out, flagged)
 }
 
-/// The issue's criterion on the counted modes, at the points within
-/// `points_within_db` of their mode's loudest (the issue's: 40 dB).
-fn assert_within_criterion(errs: &[(usize, Vec<(f64, f64)>)], points_within_db: f64) {
-    let (median, max, n) = median_max(errs, points_within_db);
+/// The issue's criterion: median ≤ 1 dB and max ≤ 3 dB over the counted
+/// modes' points within 40 dB of their mode's loudest.
+fn assert_criterion(errs: &[(usize, Vec<(f64, f64)>)]) {
+    let (median, max, n) = median_max(errs, 40.0);
     assert!(median <= 1.0 && max <= 3.0, "median {median:.3} dB, max {max:.3} dB over {n} mode-points");
-}
-
-/// What the bowls meet (see their tests): the median criterion at every point
-/// within the issue's 40 dB, the whole criterion within 30 dB.
-fn assert_bowl_criterion(errs: &[(usize, Vec<(f64, f64)>)]) {
-    let (median, _, _) = median_max(errs, 40.0);
-    assert!(median <= 1.0, "median {median:.3} dB within 40 dB");
-    assert_within_criterion(errs, 30.0);
 }
 
 #[test]
 fn demo_bar_modes_agree_with_the_bempp_reference() {
-    let (errs, left_out) = cross_check("bar8.bank", "bar8_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bar8.bank", "bar8_bempp.json", None);
     assert!(errs.len() >= 6, "at least six modes counted: {left_out:?} left out");
-    assert_within_criterion(&errs, 40.0);
+    assert_criterion(&errs);
 }
 
 /// The bowl's lowest pair (1143 Hz), in the default suite (a few seconds).
 #[test]
 fn demo_bowl_lowest_pair_agrees_with_the_bempp_reference() {
-    let (errs, _) = cross_check("bowl60.bank", "bowl60_bempp.json", Some(&[0]));
+    let (errs, _, _) = cross_check("bowl60.bank", "bowl60_bempp.json", Some(&[0]));
     assert_eq!(errs.len(), 1);
-    assert_within_criterion(&errs, 40.0);
+    assert_criterion(&errs);
 }
 
-/// The bowl's four lowest pairs, 1.1–8.1 kHz (about 3 min in the test
-/// profile on 2 loaded cores):
+/// The bowl's four lowest pairs, 1.1–8.1 kHz (about 1.5 min in the
+/// release profile on 2 loaded cores):
 /// `cargo test -p modal-radiation --test bempp_reference -- --ignored demo_bowl_modes --nocapture`.
 ///
-/// The issue's criterion holds here for the points within 30 dB of each
-/// mode's loudest, not within 40 dB: measured 2026-11-26, median 0.47 dB
-/// over all 61 counted mode-points, max 2.41 dB within 30 dB, but 3.98 dB
-/// at one point 32.3 dB below the loudest of the 5.3 kHz mode (20° off the
-/// axis under the bowl, close to that mode's axial null). How far the
-/// refine-0 reference itself is converged there is in docs/radiation.md;
-/// with `--cluster-kh 0.25` ours comes within 2.02 dB of it there.
+/// Measured 2026-11-26 at the default `κ` = 0.3: median 0.322 dB, max
+/// 1.773 dB (the 3.0 kHz pair at a point 24.8 dB below its loudest) over 61
+/// mode-points; per pair max 0.757 / 1.773 / 1.027 / 1.261 dB. The 5.3 and
+/// 8.1 kHz pairs ask for more unknowns than the dense-size cap
+/// (`MAX_DENSE_PANELS`), so their clusters are grown until they fit and the
+/// solve says "under-resolved"; at a point 33 dB down their error depends
+/// on where the grown clusters' boundaries fall (with the cap lifted to
+/// 14 000: 1.08 / 1.26 dB). At the former `κ` = 0.5: max 3.98 dB.
 #[test]
 #[ignore = "about 3 min: the bowl's four lowest pairs"]
 fn demo_bowl_modes_agree_with_the_bempp_reference() {
-    let (errs, left_out) = cross_check("bowl60.bank", "bowl60_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bowl60.bank", "bowl60_bempp.json", None);
     assert!(errs.len() == 4, "all four pairs counted: {left_out:?} left out");
-    assert_bowl_criterion(&errs);
+    assert_criterion(&errs);
 }
 
 /// The small bowl against a reference converged across its 4 mm wall.
-/// Measured 2026-11-26: median 0.35 / 0.27 dB per mode, max 1.08 dB at
-/// 4.6 kHz, but 4.09 dB at 11.4 kHz at a point 36 dB below that mode's
-/// loudest; within 30 dB of each mode's loudest the max is 1.17 dB. With
-/// finer pressure clusters (`--cluster-kh 0.25`) that point comes to
-/// 1.19 dB: the default clusters, not the reference, set the error there.
+/// Measured 2026-11-26 at the default `κ` = 0.3: median 0.036 / 0.093 dB,
+/// max 0.600 / 1.173 dB at 4.6 / 11.4 kHz. At the former `κ` = 0.5 the
+/// 11.4 kHz mode was 4.01 dB off at a point 36 dB below its loudest; one
+/// unknown per panel (`--full-resolution`) gives 1.99 dB there: that much is
+/// the panels' own error (k·h = 0.81), the rest was the clusters'.
 #[test]
 fn small_bowl_agrees_with_a_converged_bempp_reference() {
-    let (errs, left_out) = cross_check("bowl30.bank", "bowl30_bempp.json", None);
+    let (errs, left_out, _) = cross_check("bowl30.bank", "bowl30_bempp.json", None);
     assert!(errs.len() == 2, "both pairs counted: {left_out:?} left out");
-    assert_bowl_criterion(&errs);
+    assert_criterion(&errs);
+}
+
+/// A two-part object (two parallel bars 10 mm apart), its two lowest modes
+/// in the default suite.
+#[test]
+fn two_bars_lowest_modes_agree_with_the_bempp_reference() {
+    let (errs, _, _) = cross_check("twobars.bank", "twobars_bempp.json", Some(&[0, 1]));
+    assert_eq!(errs.len(), 2);
+    assert_criterion(&errs);
+}
+
+/// Every mode of the two-part object, 2.7–13.5 kHz (about 1.5 min in the
+/// release profile):
+/// `cargo test -p modal-radiation --test bempp_reference -- --ignored two_bars_every --nocapture`.
+///
+/// Measured 2026-11-26 at the default `κ` = 0.3 (this test, release
+/// profile, 85 s): all 10 modes within 15 dB of the loudest, median
+/// 0.327 dB, max 1.941 dB (mode 2, 4.4 kHz) over 160 mode-points; per mode max 0.35–0.70 dB except 1.94 (mode 2) and 1.00
+/// (mode 5). Modes 6–9 (≥ 10.8 kHz) are flagged under-resolved (the
+/// bank's 6 mm cell gives panels with k·h > 1) and still within 1 dB.
+#[test]
+#[ignore = "about 1.5 min: ten modes of a two-part object"]
+fn two_bars_every_mode_agrees_with_the_bempp_reference() {
+    let (errs, left_out, _) = cross_check("twobars.bank", "twobars_bempp.json", None);
+    assert!(errs.len() == 10, "all ten modes counted: {left_out:?} left out");
+    assert_criterion(&errs);
 }
 
 /// Re-runs the references (needs the Python packages of `tools/rad_ref.py`;
@@ -251,9 +293,9 @@ fn small_bowl_agrees_with_a_converged_bempp_reference() {
 /// `/work/venvs/bempp/bin/python`) and checks each reproduces its committed
 /// file, each mode at its recorded `refine` and `quadrature`:
 /// `cargo test -p modal-radiation --test bempp_reference -- --ignored`
-/// (about 1.5 h on 2 loaded cores: bempp's JIT compile and the dense
+/// (about 3 h on 2 loaded cores: bempp's JIT compile and the dense
 /// solves, 14 min for the bar at refine 0, 13 min for its mode 5 at refine
-/// 1, 5–10 min per mode of either bowl).
+/// 1, 5–10 min per mode of either bowl, 80 min for the two bars).
 #[test]
 #[ignore = "needs bempp-cl (Python); about 1.5 h"]
 fn the_committed_references_are_what_rad_ref_computes() {
@@ -263,6 +305,7 @@ fn the_committed_references_are_what_rad_ref_computes() {
         ("bar8.bank", "bar8_bempp.json"),
         ("bowl60.bank", "bowl60_bempp.json"),
         ("bowl30.bank", "bowl30_bempp.json"),
+        ("twobars.bank", "twobars_bempp.json"),
     ];
     for (bank, file) in objects {
         let text = std::fs::read_to_string(data(file)).unwrap();
