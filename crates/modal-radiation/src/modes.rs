@@ -332,10 +332,12 @@ pub const DEFAULT_CLUSTER_KH: f64 = 0.3;
 /// frequency).
 pub const MAX_CLUSTER_RADIUS_FRACTION: f64 = 0.5;
 
-/// Largest dense system solved (16 B × N² of memory: 6 000 unknowns ≈ 0.58
-/// GB). Above it the clusters are grown until they fit (flagged in
+/// Most pressure unknowns of one solve: the solver's dense limit
+/// ([`crate::bem::MAX_DENSE_UNKNOWNS`], its fallback when GMRES on the
+/// compressed matrix does not converge), so every solve keeps that fallback.
+/// Above it the clusters are grown until they fit (flagged in
 /// [`Progress::under_resolved`]).
-pub const MAX_DENSE_PANELS: usize = 6000;
+pub const MAX_DENSE_PANELS: usize = crate::bem::MAX_DENSE_UNKNOWNS;
 
 /// One panel level of a bank: panels, their adjacency, their near field
 /// (integrated when the level is first solved on), and how to get a mode's
