@@ -43,7 +43,7 @@
 //!   bempp-cl": refine 0 to 1 moves it by ≤ 0.9 dB, quadrature order 4 to 8
 //!   by ≤ 4e-5 of the pressure).
 //! - `twobars.bank`, **two parts**: two parallel steel bars (150 × 20 × 12 mm
-//!   and 120 × 20 × 12 mm, 10 mm apart; `twobars.obj`, 24 lines), `modal
+//!   and 120 × 20 × 12 mm, 10 mm apart; `twobars.obj`, 40 lines), `modal
 //!   precompute twobars.obj --material steel --modes 10 --cell 0.006
 //!   --accuracy off --no-cache -o twobars.bank` (2.7–13.5 kHz; each mode
 //!   moves one bar, the other scatters its sound), and `twobars_bempp.json`:
