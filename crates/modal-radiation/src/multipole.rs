@@ -33,7 +33,7 @@ use faer::c64;
 use crate::bem::{Air, SurfaceField};
 use crate::geometry::{norm, sub, BoundaryMesh};
 use crate::quadrature::TRIANGLE_3;
-use crate::special::{lm_index, spherical_bessel_j, spherical_hankel, spherical_harmonics};
+use crate::special::{lm_index, spherical_bessel_j, spherical_hankel, spherical_harmonics, Harmonics};
 
 /// Extra degrees above `kR` in the fit (the near-field tail at
 /// `r_fit = 2R` falls like `2^{−l}`, so 16 more degrees reach ≈ 1e-5).
@@ -125,13 +125,18 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
     let delta = 1e-4 * (1.0 / k).min(radius);
     let nf = fields.len();
     let zero = c64::new(0.0, 0.0);
-    // ψ_lm*(y) for every (l, m).
-    let regular = |y: [f64; 3]| -> Vec<c64> {
+    let harmonics = Harmonics::new(cap);
+    // ψ_lm*(y) for every (l, m), into `out`.
+    let regular = |y: [f64; 3], out: &mut [c64]| {
         let d = sub(y, centre);
         let r = norm(d);
         let j = spherical_bessel_j(cap, k * r);
-        let yl = spherical_harmonics(cap, if r > 0.0 { d } else { [0.0, 0.0, 1.0] });
-        yl.iter().enumerate().map(|(i, v)| v.conj() * j[(i as f64).sqrt() as usize]).collect()
+        harmonics.evaluate(if r > 0.0 { d } else { [0.0, 0.0, 1.0] }, out);
+        for (l, jl) in j.iter().enumerate() {
+            for v in &mut out[l * l..(l + 1) * (l + 1)] {
+                *v = v.conj() * jl;
+            }
+        }
     };
     const CHUNK: usize = 64;
     let partial: Vec<Vec<c64>> = mesh
@@ -140,20 +145,26 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
         .enumerate()
         .map(|(c, chunk)| {
             let mut acc = vec![zero; nf * ncoef];
+            // ψ* at y + δn and y − δn, then their difference and sum.
+            let (mut plus, mut minus) = (vec![zero; ncoef], vec![zero; ncoef]);
             for (o, p) in chunk.iter().enumerate() {
                 let j = c * CHUNK + o;
                 let [a, b, cc] = p.corners.map(|i| mesh.vertices[i]);
                 for (bary, w) in TRIANGLE_3 {
                     let y = [0, 1, 2].map(|q| bary[0] * a[q] + bary[1] * b[q] + bary[2] * cc[q]);
-                    let plus = regular([0, 1, 2].map(|q| y[q] + delta * p.normal[q]));
-                    let minus = regular([0, 1, 2].map(|q| y[q] - delta * p.normal[q]));
+                    regular([0, 1, 2].map(|q| y[q] + delta * p.normal[q]), &mut plus);
+                    regular([0, 1, 2].map(|q| y[q] - delta * p.normal[q]), &mut minus);
+                    for (u, v) in plus.iter_mut().zip(minus.iter_mut()) {
+                        (*u, *v) = (*u - *v, *u + *v);
+                    }
+                    let (difference, sum) = (&plus, &minus);
                     let wa = w * p.area;
                     for (f, field) in fields.iter().enumerate() {
                         let pw = field.pressure[j] * (wa / (2.0 * delta));
                         let qw = field.dpdn(j) * (0.5 * wa);
                         let out = &mut acc[f * ncoef..(f + 1) * ncoef];
                         for i in 0..ncoef {
-                            out[i] += pw * (plus[i] - minus[i]) - qw * (plus[i] + minus[i]);
+                            out[i] += pw * difference[i] - qw * sum[i];
                         }
                     }
                 }

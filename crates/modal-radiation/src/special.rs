@@ -97,54 +97,113 @@ pub fn lm_index(l: usize, m: i64) -> usize {
 
 /// Orthonormal complex spherical harmonics `Y_l^m(d̂)` for every
 /// `l ≤ order`, `|m| ≤ l`, at the direction `d` (need not be unit length,
-/// must be non-zero), in the order of [`lm_index`].
+/// must be non-zero), in the order of [`lm_index`]. For many directions at
+/// one order, [`Harmonics`] keeps the recurrence's coefficients and the
+/// output buffer (same values, bit for bit).
 pub fn spherical_harmonics(order: usize, d: [f64; 3]) -> Vec<c64> {
-    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let x = d[2] / r;
-    let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    let (cos_phi, sin_phi) = if rho > 0.0 { (d[0] / rho, d[1] / rho) } else { (1.0, 0.0) };
-    let s = rho / r; // sin θ ≥ 0
-    let q = normalized_legendre(order, x, s);
     let mut y = vec![c64::new(0.0, 0.0); (order + 1) * (order + 1)];
-    // e^{imφ} by repeated multiplication.
-    let mut eim = c64::new(1.0, 0.0);
-    let e1 = c64::new(cos_phi, sin_phi);
-    for m in 0..=order {
-        let sign = if m % 2 == 0 { 1.0 } else { -1.0 };
-        for l in m..=order {
-            let v = eim * q[l * (order + 1) + m];
-            y[lm_index(l, m as i64)] = v;
-            if m > 0 {
-                y[lm_index(l, -(m as i64))] = v.conj() * sign;
-            }
-        }
-        eim *= e1;
-    }
+    Harmonics::new(order).evaluate(d, &mut y);
     y
 }
 
-/// `Q_l^m(x)` for `0 ≤ m ≤ l ≤ order`, stored at `l·(order+1) + m`, with
-/// `x = cos θ`, `s = sin θ ≥ 0`.
-fn normalized_legendre(order: usize, x: f64, s: f64) -> Vec<f64> {
-    let n = order + 1;
-    let mut q = vec![0.0; n * n];
-    let mut qmm = (1.0 / (4.0 * std::f64::consts::PI)).sqrt();
-    for m in 0..=order {
-        if m > 0 {
-            qmm *= -((2 * m + 1) as f64 / (2 * m) as f64).sqrt() * s;
+/// The coefficients of the normalized associated Legendre recurrence up to
+/// one degree `L`, computed once (two square roots per `(l, m)`, which
+/// otherwise dominate an evaluation):
+///
+/// `Q_m^m = c_m s Q_{m−1}^{m−1}`, `c_m = −√((2m+1)/(2m))`, `Q_0^0 = 1/√(4π)`;
+/// `Q_{m+1}^m = √(2m+3) x Q_m^m`;
+/// `Q_l^m = a_lm (x Q_{l−1}^m − b_lm Q_{l−2}^m)`,
+/// `a_lm = √((4l²−1)/(l²−m²))`, `b_lm = √(((l−1)²−m²)/(4(l−1)²−1))`,
+///
+/// `x = cos θ`, `s = sin θ`, and `Y_l^m = Q_l^m e^{imφ}`,
+/// `Y_l^{−m} = (−1)^m conj(Y_l^m)`.
+#[derive(Clone, Debug)]
+pub struct Harmonics {
+    order: usize,
+    /// `c_m` for `m = 0..=L` (`c_0` unused).
+    diagonal: Vec<f64>,
+    /// `√(2m+3)`.
+    first: Vec<f64>,
+    /// `(a_lm, b_lm)` at `l·(L+1) + m`.
+    recurrence: Vec<(f64, f64)>,
+}
+
+impl Harmonics {
+    /// The table for degrees `0..=order`.
+    pub fn new(order: usize) -> Harmonics {
+        let n = order + 1;
+        let mut recurrence = vec![(0.0, 0.0); n * n];
+        for m in 0..=order {
+            for l in m + 2..=order {
+                let (lf, mf) = (l as f64, m as f64);
+                let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
+                let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0)).sqrt();
+                recurrence[l * n + m] = (a, b);
+            }
         }
-        q[m * n + m] = qmm;
-        if m < order {
-            q[(m + 1) * n + m] = ((2 * m + 3) as f64).sqrt() * x * qmm;
-        }
-        for l in m + 2..=order {
-            let (lf, mf) = (l as f64, m as f64);
-            let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
-            let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0)).sqrt();
-            q[l * n + m] = a * (x * q[(l - 1) * n + m] - b * q[(l - 2) * n + m]);
+        Harmonics {
+            order,
+            diagonal: (0..=order)
+                .map(|m| if m == 0 { 0.0 } else { -((2 * m + 1) as f64 / (2 * m) as f64).sqrt() })
+                .collect(),
+            first: (0..=order).map(|m| ((2 * m + 3) as f64).sqrt()).collect(),
+            recurrence,
         }
     }
-    q
+
+    /// Highest degree `L`.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Writes `Y_l^m(d̂)` for `l ≤ L` into `y[lm_index(l, m)]`
+    /// (`y.len() ≥ (L+1)²`; `d` need not be unit length, must be non-zero).
+    pub fn evaluate(&self, d: [f64; 3], y: &mut [c64]) {
+        self.evaluate_to(self.order, d, y);
+    }
+
+    /// [`Harmonics::evaluate`] for the degrees `l ≤ order ≤ L` only
+    /// (`y.len() ≥ (order+1)²`).
+    pub fn evaluate_to(&self, order: usize, d: [f64; 3], y: &mut [c64]) {
+        assert!(order <= self.order, "degree {order} above the table's {}", self.order);
+        let n = self.order + 1;
+        debug_assert!(y.len() >= (order + 1) * (order + 1));
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let x = d[2] / r;
+        let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let (cos_phi, sin_phi) = if rho > 0.0 { (d[0] / rho, d[1] / rho) } else { (1.0, 0.0) };
+        let s = rho / r; // sin θ ≥ 0
+                         // e^{imφ} by repeated multiplication.
+        let mut eim = c64::new(1.0, 0.0);
+        let e1 = c64::new(cos_phi, sin_phi);
+        let mut qmm = (1.0 / (4.0 * std::f64::consts::PI)).sqrt();
+        for m in 0..=order {
+            if m > 0 {
+                qmm *= self.diagonal[m] * s;
+            }
+            let sign = if m % 2 == 0 { 1.0 } else { -1.0 };
+            let mut put = |l: usize, q: f64| {
+                let v = eim * q;
+                y[lm_index(l, m as i64)] = v;
+                if m > 0 {
+                    y[lm_index(l, -(m as i64))] = v.conj() * sign;
+                }
+            };
+            put(m, qmm);
+            if m < order {
+                let (mut below, mut here) = (qmm, self.first[m] * x * qmm);
+                put(m + 1, here);
+                for l in m + 2..=order {
+                    let (a, b) = self.recurrence[l * n + m];
+                    let next = a * (x * here - b * below);
+                    put(l, next);
+                    below = here;
+                    here = next;
+                }
+            }
+            eim *= e1;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -246,5 +305,24 @@ mod tests {
         let r = (0.09f64 + 0.04 + 0.25).sqrt();
         let want = (3.0 / (4.0 * std::f64::consts::PI)).sqrt() * 0.5 / r;
         assert!((y[lm_index(1, 0)].re - want).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_table_evaluates_any_lower_degree_and_reuses_its_buffer() {
+        // The table of degree 12 indexes its recurrence by 13 columns; a
+        // degree-5 evaluation must still equal a fresh degree-5 one, and a
+        // dirty buffer must be fully overwritten.
+        let table = Harmonics::new(12);
+        let mut y = vec![c64::new(f64::NAN, f64::NAN); 13 * 13];
+        for d in [[0.3, -0.2, 0.5], [0.0, 0.0, -2.0], [1.0, 2.0, 0.0]] {
+            table.evaluate_to(5, d, &mut y);
+            let fresh = Harmonics::new(5);
+            let mut want = vec![c64::new(0.0, 0.0); 36];
+            fresh.evaluate(d, &mut want);
+            assert_eq!(&y[..36], &want[..]);
+            table.evaluate(d, &mut y);
+            assert_eq!(y, spherical_harmonics(12, d));
+            assert!(y.iter().all(|v| v.re.is_finite() && v.im.is_finite()));
+        }
     }
 }

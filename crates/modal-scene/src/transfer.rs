@@ -46,7 +46,7 @@
 use std::sync::{Arc, Mutex};
 
 use modal_bank::{ModeBank, RadiationTable};
-use modal_radiation::special::spherical_harmonics;
+use modal_radiation::special::Harmonics;
 use modal_synth::{OutputModulation, C64};
 
 use crate::listener::Trajectory;
@@ -72,6 +72,8 @@ pub(crate) struct BankTransfer {
     /// Radius beyond which the expansions are accurate [m].
     fit_radius: f64,
     modes: Vec<Option<ModeExpansion>>,
+    /// Spherical harmonics up to the highest expansion order.
+    harmonics: Harmonics,
     /// Per mode: the voice's real gain `g_i` [Pa·m per m/s of modal velocity].
     pub gains: Vec<f64>,
     /// Modes with a table entry.
@@ -128,10 +130,12 @@ impl BankTransfer {
             modes[entry.mode] = Some(ModeExpansion { k, order: entry.order, scaled });
         }
         let com = bank.mass.center_of_mass_m;
+        let top = modes.iter().flatten().map(|m| m.order).max().unwrap_or(0);
         BankTransfer {
             centre_offset: [0, 1, 2].map(|q| table.centre_m[q] - com[q]),
             fit_radius: table.fit_radius_m,
             modes,
+            harmonics: Harmonics::new(top),
             gains,
             with_transfer,
             levels,
@@ -148,7 +152,8 @@ impl BankTransfer {
             out.iter_mut().zip(modes).for_each(|(o, &i)| *o = self.fallback(i));
             return;
         };
-        let y = spherical_harmonics(order, x);
+        let mut y = vec![modal_radiation::c64::new(0.0, 0.0); (order + 1) * (order + 1)];
+        self.harmonics.evaluate_to(order, x, &mut y);
         let r_eval = r.max(self.fit_radius);
         let mut eta = Vec::with_capacity(order + 1);
         for (o, &i) in out.iter_mut().zip(modes) {
