@@ -33,6 +33,23 @@
 //! factors are kept; the right-hand side's block is used once,
 //! `b_τ += U (V_fᵀ 1) / s_f`.
 //!
+//! Each entry is evaluated once per block: the rows and columns ACA
+//! fetched are kept, a column reads the fetched rows it crosses and a row
+//! the fetched columns, and a block ACA gives up on is completed dense
+//! from them (it gave up after `m/2` rows and as many columns, a quarter
+//! of its entries left). Measured on the demo bowl at 5 296 Hz (5 707
+//! unknowns): 5 485 of the 6 488 admissible blocks give up (ranks ≈ 23 of
+//! 32 even by SVD at `ε`), 36 % of the stored entries; evaluating them
+//! twice had cost 17 % of the assembly.
+//!
+//! ACA's rank overshoots the SVD's: each low-rank `A` block is then
+//! recompressed to `ε` ([`crate::lowrank`]; the right-hand side is taken
+//! before). Measured on the demo bowl (release, load ≈ 4, paired runs):
+//! at 5 296 Hz largest rank 85 → 60, stored entries 16.6 M → 14.5 M (51 %
+//! → 44 % of `n²`), +1.0–1.3 s of assembly against 1.9–3.4 s less in the
+//! GMRES solves of its two right-hand sides; at 11 243 Hz 60 % → 53 %,
+//! +0–0.9 s against 1.6–2.8 s less; levels within 4·10⁻⁵ dB.
+//!
 //! Cost: `r (m + n_σ)` entries per far block instead of `m n_σ`, and the
 //! product `A x` in the stored entries instead of `n²`.
 //!
@@ -198,8 +215,7 @@ impl HMatrix {
             .map(|(t, s, admissible)| {
                 let (nt, ns) = (&tree.nodes[t], &tree.nodes[s]);
                 let (rows, cols) = (&perm[nt.start..nt.end], &perm[ns.start..ns.end]);
-                let low = if admissible { low_rank(asm, rows, cols) } else { None };
-                let (data, rhs) = low.unwrap_or_else(|| dense(asm, rows, cols));
+                let (data, rhs) = block(asm, rows, cols, admissible);
                 (Block { rows: (nt.start, nt.end), cols: (ns.start, ns.end), data }, rhs)
             })
             .collect();
@@ -322,75 +338,204 @@ fn dot(a: &[c64], b: &[c64]) -> c64 {
     a.iter().zip(b).fold(c64::new(0.0, 0.0), |s, (x, y)| s + x * y)
 }
 
-/// The dense block of `rows × cols` and its right-hand side part
-/// (row-major `m × nrhs`).
-fn dense(asm: &Assembly<'_>, rows: &[usize], cols: &[usize]) -> (Data, Vec<c64>) {
-    let (m, width, nrhs) = (rows.len(), cols.len(), asm.fields().len().max(1));
-    let zero = c64::new(0.0, 0.0);
-    let mut d = vec![zero; m * width];
-    let mut rhs = vec![zero; m * nrhs];
-    let mut parts = vec![zero; width * nrhs];
-    for ((&i, row), b) in rows.iter().zip(d.chunks_mut(width)).zip(rhs.chunks_mut(nrhs)) {
-        asm.row(i, cols, row, &mut parts);
-        for part in parts.chunks(nrhs) {
-            for (bf, p) in b.iter_mut().zip(part) {
-                *bf += p;
+/// The entries of one block `rows × cols` fetched so far, as whole rows
+/// and whole columns of `A` and of each source's right-hand-side parts
+/// ([`Assembly::row`]): ACA asks for each entry once (a column crossing a
+/// fetched row reads it, and so on), and a block ACA gives up on is
+/// completed dense from them: it gave up after `m/2` rows and as many
+/// columns, so only a quarter of its entries are left to evaluate.
+struct Entries<'a, 'b> {
+    asm: &'a Assembly<'b>,
+    rows: &'a [usize],
+    cols: &'a [usize],
+    /// Right-hand sides, at least one (the layout of [`Assembly::row`]).
+    nrhs: usize,
+    /// Where each block row (column) is among the fetched ones.
+    row_at: Vec<Option<usize>>,
+    col_at: Vec<Option<usize>>,
+    /// Fetched rows: `A` (`n_σ`) and the parts (`n_σ × nrhs`, row-major).
+    fetched_rows: Vec<(Vec<c64>, Vec<c64>)>,
+    /// Fetched columns: `A` (`m`) and the parts (`m × nrhs`, row-major).
+    fetched_cols: Vec<(Vec<c64>, Vec<c64>)>,
+}
+
+impl<'a, 'b> Entries<'a, 'b> {
+    fn new(asm: &'a Assembly<'b>, rows: &'a [usize], cols: &'a [usize]) -> Self {
+        Entries {
+            asm,
+            rows,
+            cols,
+            nrhs: asm.fields().len().max(1),
+            row_at: vec![None; rows.len()],
+            col_at: vec![None; cols.len()],
+            fetched_rows: Vec::new(),
+            fetched_cols: Vec::new(),
+        }
+    }
+
+    /// Row `i` of the block, `A` and parts: evaluated where no fetched
+    /// column crosses it.
+    fn row(&mut self, i: usize) -> &(Vec<c64>, Vec<c64>) {
+        if self.row_at[i].is_none() {
+            let (width, nrhs) = (self.cols.len(), self.nrhs);
+            let zero = c64::new(0.0, 0.0);
+            let todo: Vec<usize> = (0..width).filter(|&c| self.col_at[c].is_none()).collect();
+            let sources: Vec<usize> = todo.iter().map(|&c| self.cols[c]).collect();
+            let (mut a, mut parts) = (vec![zero; todo.len()], vec![zero; todo.len() * nrhs]);
+            self.asm.row(self.rows[i], &sources, &mut a, &mut parts);
+            let (mut ra, mut rp) = (vec![zero; width], vec![zero; width * nrhs]);
+            for (t, &c) in todo.iter().enumerate() {
+                ra[c] = a[t];
+                rp[c * nrhs..(c + 1) * nrhs].copy_from_slice(&parts[t * nrhs..(t + 1) * nrhs]);
+            }
+            for (c, at) in self.col_at.iter().enumerate() {
+                if let Some(k) = at {
+                    let (ca, cp) = &self.fetched_cols[*k];
+                    ra[c] = ca[i];
+                    rp[c * nrhs..(c + 1) * nrhs].copy_from_slice(&cp[i * nrhs..(i + 1) * nrhs]);
+                }
+            }
+            self.row_at[i] = Some(self.fetched_rows.len());
+            self.fetched_rows.push((ra, rp));
+        }
+        self.row_at[i].map(|k| &self.fetched_rows[k]).unwrap_or_else(|| unreachable!())
+    }
+
+    /// Column `c` of the block, `A` and parts: evaluated where no fetched
+    /// row crosses it.
+    fn col(&mut self, c: usize) -> &(Vec<c64>, Vec<c64>) {
+        if self.col_at[c].is_none() {
+            let (m, nrhs) = (self.rows.len(), self.nrhs);
+            let zero = c64::new(0.0, 0.0);
+            let (mut ca, mut cp) = (vec![zero; m], vec![zero; m * nrhs]);
+            for (i, at) in self.row_at.iter().enumerate() {
+                let (a, p) = (&mut ca[i..=i], &mut cp[i * nrhs..(i + 1) * nrhs]);
+                match at {
+                    Some(k) => {
+                        let (ra, rp) = &self.fetched_rows[*k];
+                        a[0] = ra[c];
+                        p.copy_from_slice(&rp[c * nrhs..(c + 1) * nrhs]);
+                    }
+                    None => self.asm.row(self.rows[i], &self.cols[c..=c], a, p),
+                }
+            }
+            self.col_at[c] = Some(self.fetched_cols.len());
+            self.fetched_cols.push((ca, cp));
+        }
+        self.col_at[c].map(|k| &self.fetched_cols[k]).unwrap_or_else(|| unreachable!())
+    }
+
+    /// The whole block, dense, and its right-hand side part (row-major
+    /// `m × nrhs`, each row's parts summed in column order).
+    fn dense(mut self) -> (Data, Vec<c64>) {
+        let (m, width, nrhs) = (self.rows.len(), self.cols.len(), self.nrhs);
+        let zero = c64::new(0.0, 0.0);
+        let mut d = vec![zero; m * width];
+        let mut rhs = vec![zero; m * nrhs];
+        for ((i, row), b) in d.chunks_mut(width.max(1)).enumerate().zip(rhs.chunks_mut(nrhs)) {
+            let (a, parts) = self.row(i);
+            row.copy_from_slice(a);
+            for part in parts.chunks(nrhs) {
+                for (bf, p) in b.iter_mut().zip(part) {
+                    *bf += p;
+                }
+            }
+        }
+        (Data::Dense(d), rhs)
+    }
+}
+
+/// `M ≈ Σ_k u_k v_kᵀ` for [`aca`]: a matrix given by its rows and columns.
+trait Crosses {
+    /// Rows of `M`.
+    fn rows(&self) -> usize;
+    /// Columns of `M`.
+    fn cols(&self) -> usize;
+    /// Row `i` into `out`.
+    fn row(&mut self, i: usize, out: &mut [c64]);
+    /// Column `j` into `out`.
+    fn col(&mut self, j: usize, out: &mut [c64]);
+}
+
+/// The side-by-side block `[A | s_1 R_1 | …]` (module doc) of some entries.
+struct SideBySide<'e, 'a, 'b> {
+    entries: &'e mut Entries<'a, 'b>,
+    /// `s_f`.
+    scale: Vec<f64>,
+    /// Right-hand sides (`scale.len()`, possibly 0).
+    fields: usize,
+}
+
+impl Crosses for SideBySide<'_, '_, '_> {
+    fn rows(&self) -> usize {
+        self.entries.rows.len()
+    }
+
+    fn cols(&self) -> usize {
+        self.entries.cols.len() * (1 + self.fields)
+    }
+
+    fn row(&mut self, i: usize, out: &mut [c64]) {
+        let (width, nrhs) = (self.entries.cols.len(), self.entries.nrhs);
+        let (a, parts) = self.entries.row(i);
+        out[..width].copy_from_slice(a);
+        for (f, s) in self.scale.iter().enumerate() {
+            for (c, x) in out[(1 + f) * width..(2 + f) * width].iter_mut().enumerate() {
+                *x = parts[c * nrhs + f] * s;
             }
         }
     }
-    (Data::Dense(d), rhs)
-}
 
-/// The low-rank block of `rows × cols` (module doc) and its right-hand
-/// side part, or `None` when ACA needs more than half the smaller side.
-fn low_rank(asm: &Assembly<'_>, rows: &[usize], cols: &[usize]) -> Option<(Data, Vec<c64>)> {
-    let (m, width, nrhs) = (rows.len(), cols.len(), asm.fields().len());
-    let zero = c64::new(0.0, 0.0);
-    // One row of [A | R_1 | …] unscaled: A's entries, then each field's.
-    let fetch = |i: usize, a: &mut [c64], r: &mut [c64]| {
-        let mut parts = vec![zero; width * nrhs.max(1)];
-        asm.row(rows[i], cols, a, &mut parts);
-        for f in 0..nrhs {
-            for (c, x) in r[f * width..(f + 1) * width].iter_mut().enumerate() {
-                *x = parts[c * nrhs + f];
+    fn col(&mut self, j: usize, out: &mut [c64]) {
+        let (width, nrhs) = (self.entries.cols.len(), self.entries.nrhs);
+        let (part, c) = (j / width, j % width);
+        let (a, parts) = self.entries.col(c);
+        if part == 0 {
+            out.copy_from_slice(a);
+        } else {
+            let s = self.scale[part - 1];
+            for (o, p) in out.iter_mut().zip(parts.chunks(nrhs)) {
+                *o = p[part - 1] * s;
             }
         }
-    };
-    let (mut a0, mut r0) = (vec![zero; width], vec![zero; width * nrhs]);
-    fetch(0, &mut a0, &mut r0);
-    let size = |v: &[c64]| v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-    let scale: Vec<f64> = r0
-        .chunks(width.max(1))
-        .map(|r| {
-            let s = size(r);
+    }
+}
+
+/// The block `rows × cols` (module doc) and its right-hand side part
+/// (row-major `m × nrhs`): low rank when `admissible` and ACA finds it
+/// within half the smaller side, dense otherwise.
+fn block(asm: &Assembly<'_>, rows: &[usize], cols: &[usize], admissible: bool) -> (Data, Vec<c64>) {
+    let mut entries = Entries::new(asm, rows, cols);
+    if admissible {
+        if let Some(low) = low_rank(&mut entries) {
+            return low;
+        }
+    }
+    entries.dense()
+}
+
+/// The low-rank block of some entries (module doc) and its right-hand
+/// side part, or `None` when ACA needs more than half the smaller side.
+fn low_rank(entries: &mut Entries<'_, '_>) -> Option<(Data, Vec<c64>)> {
+    let (m, width, nrhs) = (entries.rows.len(), entries.cols.len(), entries.asm.fields().len());
+    let (zero, stride) = (c64::new(0.0, 0.0), entries.nrhs);
+    let (a0, p0) = entries.row(0);
+    let a0 = a0.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    let scale: Vec<f64> = (0..nrhs)
+        .map(|f| {
+            let s = p0.chunks(stride).map(|p| p[f].norm_sqr()).sum::<f64>().sqrt();
             if s > 0.0 {
-                size(&a0).max(f64::MIN_POSITIVE) / s
+                a0 / s
             } else {
                 1.0
             }
         })
         .collect();
-    let full = width * (1 + nrhs);
-    let row = |i: usize, out: &mut [c64]| {
-        let (a, r) = out.split_at_mut(width);
-        fetch(i, a, r);
-        for (f, s) in scale.iter().enumerate() {
-            r[f * width..(f + 1) * width].iter_mut().for_each(|x| *x *= s);
-        }
-    };
-    let col = |j: usize, out: &mut [c64]| {
-        let (part, c) = (j / width, j % width);
-        let mut b = vec![zero; nrhs.max(1)];
-        for (o, &i) in out.iter_mut().zip(rows) {
-            let mut a = [zero];
-            asm.row(i, &cols[c..=c], &mut a, &mut b);
-            *o = if part == 0 { a[0] } else { b[part - 1] * scale[part - 1] };
-        }
-    };
-    let (u, v) = aca(m, full, &row, &col, m.min(width) / 2)?;
-    let w = v.iter().map(|vk| vk[..width].to_vec()).collect();
+    let mut side = SideBySide { entries, scale, fields: nrhs };
+    let (u, v) = aca(&mut side, m.min(width) / 2)?;
+    let w: Vec<Vec<c64>> = v.iter().map(|vk| vk[..width].to_vec()).collect();
     let mut rhs = vec![zero; m * nrhs];
-    for (f, s) in scale.iter().enumerate() {
+    for (f, s) in side.scale.iter().enumerate() {
         for (uk, vk) in u.iter().zip(&v) {
             let t = vk[(1 + f) * width..(2 + f) * width].iter().sum::<c64>() / s;
             for (i, ui) in uk.iter().enumerate() {
@@ -398,20 +543,16 @@ fn low_rank(asm: &Assembly<'_>, rows: &[usize], cols: &[usize]) -> Option<(Data,
             }
         }
     }
+    let (u, w) = crate::lowrank::recompress(&u, &w, ACA_TOLERANCE).unwrap_or((u, w));
     Some((Data::LowRank { u, w }, rhs))
 }
 
 /// Partial-pivoting ACA (module doc) of an `m × n` matrix given by its rows
-/// `row(i, out)` and columns `col(j, out)`: `(U, V)` with `M ≈ Σ_k u_k v_kᵀ`
-/// to [`ACA_TOLERANCE`], or `None` when the rank would pass `max_rank`.
+/// and columns: `(U, V)` with `M ≈ Σ_k u_k v_kᵀ` to [`ACA_TOLERANCE`], or
+/// `None` when the rank would pass `max_rank`.
 #[allow(clippy::type_complexity)]
-fn aca(
-    m: usize,
-    n: usize,
-    row: &dyn Fn(usize, &mut [c64]),
-    col: &dyn Fn(usize, &mut [c64]),
-    max_rank: usize,
-) -> Option<(Vec<Vec<c64>>, Vec<Vec<c64>>)> {
+fn aca(mat: &mut dyn Crosses, max_rank: usize) -> Option<(Vec<Vec<c64>>, Vec<Vec<c64>>)> {
+    let (m, n) = (mat.rows(), mat.cols());
     let zero = c64::new(0.0, 0.0);
     let (mut us, mut vs): (Vec<Vec<c64>>, Vec<Vec<c64>>) = (Vec::new(), Vec::new());
     let mut used = vec![false; m];
@@ -420,7 +561,7 @@ fn aca(
     loop {
         used[i] = true;
         let mut r = vec![zero; n];
-        row(i, &mut r);
+        mat.row(i, &mut r);
         for (uk, vk) in us.iter().zip(&vs) {
             let a = uk[i];
             for (x, v) in r.iter_mut().zip(vk) {
@@ -451,7 +592,7 @@ fn aca(
         let inv = 1.0 / r[j];
         let v: Vec<c64> = r.iter().map(|x| x * inv).collect();
         let mut u = vec![zero; m];
-        col(j, &mut u);
+        mat.col(j, &mut u);
         for (uk, vk) in us.iter().zip(&vs) {
             let a = vk[j];
             for (x, w) in u.iter_mut().zip(uk) {
@@ -489,6 +630,24 @@ fn cdot(a: &[c64], b: &[c64]) -> c64 {
 mod tests {
     use super::*;
 
+    /// An `m × n` matrix given entry by entry.
+    pub(super) struct Entrywise<F: Fn(usize, usize) -> c64>(pub usize, pub usize, pub F);
+
+    impl<F: Fn(usize, usize) -> c64> Crosses for Entrywise<F> {
+        fn rows(&self) -> usize {
+            self.0
+        }
+        fn cols(&self) -> usize {
+            self.1
+        }
+        fn row(&mut self, i: usize, out: &mut [c64]) {
+            out.iter_mut().enumerate().for_each(|(j, o)| *o = (self.2)(i, j));
+        }
+        fn col(&mut self, j: usize, out: &mut [c64]) {
+            out.iter_mut().enumerate().for_each(|(i, o)| *o = (self.2)(i, j));
+        }
+    }
+
     #[test]
     fn aca_recovers_a_smooth_kernel_block_to_its_tolerance() {
         // e^{ik|x−y|}/|x−y| between two separated point rows: numerically low rank.
@@ -499,14 +658,7 @@ mod tests {
             let r = ys[j] - xs[i];
             c64::new((k * r).cos(), (k * r).sin()) / r
         };
-        let (u, v) = aca(
-            60,
-            80,
-            &|i, out: &mut [c64]| out.iter_mut().enumerate().for_each(|(j, o)| *o = f(i, j)),
-            &|j, out: &mut [c64]| out.iter_mut().enumerate().for_each(|(i, o)| *o = f(i, j)),
-            30,
-        )
-        .expect("low rank");
+        let (u, v) = aca(&mut Entrywise(60, 80, f), 30).expect("low rank");
         assert!(u.len() < 15, "rank {}", u.len());
         let (mut err, mut size) = (0.0, 0.0);
         for i in 0..60 {
@@ -523,13 +675,7 @@ mod tests {
     #[test]
     fn a_full_rank_block_gives_up() {
         let id = |i: usize, j: usize| c64::new(if i == j { 1.0 } else { 0.0 }, 0.0);
-        let r = aca(
-            20,
-            20,
-            &|i, out: &mut [c64]| out.iter_mut().enumerate().for_each(|(j, o)| *o = id(i, j)),
-            &|j, out: &mut [c64]| out.iter_mut().enumerate().for_each(|(i, o)| *o = id(i, j)),
-            10,
-        );
+        let r = aca(&mut Entrywise(20, 20, id), 10);
         assert!(r.is_none());
     }
 
@@ -569,6 +715,46 @@ mod system_tests {
     use crate::kernels::Kernels;
     use crate::near::NearField;
 
+    /// Two velocity fields on `mesh`: the normal velocity of a rigid motion
+    /// along z, and the same plus an imaginary part varying along x.
+    fn two_fields(mesh: &crate::geometry::BoundaryMesh) -> Vec<Vec<c64>> {
+        [0.0, 1.0]
+            .iter()
+            .map(|s| mesh.panels.iter().map(|p| c64::new(p.normal[2], s * 30.0 * p.centroid[0])).collect())
+            .collect()
+    }
+
+    /// A block completed from the rows and columns fetched so far holds the
+    /// entries and right-hand side of a direct evaluation, bit for bit.
+    #[test]
+    fn fetched_rows_and_columns_complete_the_block_exactly() {
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 2);
+        let near = NearField::new(&mesh);
+        let k = 2.0 * std::f64::consts::PI * 3000.0 / 343.0;
+        let clusters = Clusters::identity(mesh.len());
+        let fields = two_fields(&mesh);
+        let kern = Kernels::new(k);
+        let asm = Assembly::new(&mesh, &near, &clusters, &kern, c64::new(0.0, 1.0 / k), &fields, true);
+        let rows: Vec<usize> = (0..asm.len()).step_by(7).take(30).collect();
+        let cols: Vec<usize> = (3..asm.len()).step_by(5).take(40).collect();
+        let (m, n, nrhs) = (rows.len(), cols.len(), fields.len());
+        let zero = c64::new(0.0, 0.0);
+        let mut entries = Entries::new(&asm, &rows, &cols);
+        for (i, c) in [(4, 9), (0, 0), (17, 39), (4, 21)] {
+            entries.col(c);
+            entries.row(i);
+        }
+        let (Data::Dense(d), rhs) = entries.dense() else { panic!("dense block expected") };
+        let (mut a, mut parts) = (vec![zero; n], vec![zero; n * nrhs]);
+        for (i, &row) in rows.iter().enumerate() {
+            asm.row(row, &cols, &mut a, &mut parts);
+            assert!(d[i * n..(i + 1) * n] == a[..], "row {i}");
+            let b: Vec<c64> = (0..nrhs).map(|f| parts.chunks(nrhs).fold(zero, |s, p| s + p[f])).collect();
+            assert!(rhs[i * nrhs..(i + 1) * nrhs] == b[..], "right-hand side of row {i}");
+        }
+        assert_eq!(d.len(), m * n);
+    }
+
     /// The compressed matrix against the dense assembly of the same system
     /// (an ellipsoid, 1 280 panels, 6 kHz, two fields): product
     /// with a fixed vector, diagonal and right-hand sides; and the same bits
@@ -581,10 +767,7 @@ mod system_tests {
         let near = NearField::new(&mesh);
         let k = 2.0 * std::f64::consts::PI * 6000.0 / 343.0;
         let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), 0.6 / k);
-        let fields: Vec<Vec<c64>> = [0.0, 1.0]
-            .iter()
-            .map(|s| mesh.panels.iter().map(|p| c64::new(p.normal[2], s * 30.0 * p.centroid[0])).collect())
-            .collect();
+        let fields = two_fields(&mesh);
         let kern = Kernels::new(k);
         let asm = Assembly::new(&mesh, &near, &clusters, &kern, c64::new(0.0, 1.0 / k), &fields, true);
         let n = asm.len();

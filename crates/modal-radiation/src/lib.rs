@@ -38,6 +38,7 @@ pub mod geometry;
 pub mod gmres;
 pub mod hmatrix;
 pub mod kernels;
+pub mod lowrank;
 pub mod mfs;
 pub mod modes;
 pub mod multipole;
