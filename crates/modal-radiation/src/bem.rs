@@ -43,6 +43,7 @@ use crate::geometry::BoundaryMesh;
 use crate::hmatrix::HMatrix;
 use crate::kernels::Kernels;
 use crate::near::NearField;
+use crate::precond::BlockJacobi;
 
 /// Properties of the air.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -230,7 +231,7 @@ pub fn solve_on(
                 return None;
             }
             let (mut at, mut rhs) = assemble_dense(&asm);
-            iterative_solve(&at, clusters.len(), &rhs, nrhs)
+            iterative_solve(&asm, &at, &rhs)
                 .or_else(|| lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs))
         })
         .ok_or(RadiationError::Singular { frequency_hz })?;
@@ -264,39 +265,50 @@ pub const HMATRIX_MIN_UNKNOWNS: usize = 4000;
 /// the fallback when GMRES on the compressed matrix does not converge.
 pub const MAX_DENSE_UNKNOWNS: usize = 6000;
 
-/// The compressed system solved by GMRES ([`crate::gmres::solve_with`]);
-/// `None` when any field does not converge.
+/// The compressed system solved by GMRES ([`crate::gmres::solve_many`],
+/// all fields at once), preconditioned by the diagonal blocks of the
+/// cluster tree's leaves ([`crate::precond`]); `None` when a block is
+/// singular or any field does not converge.
 fn compressed_solve(asm: &Assembly<'_>) -> Option<Mat<c64>> {
     let (h, rhs) = HMatrix::assemble(asm);
-    let (n, nrhs) = (asm.len(), asm.fields().len());
-    let mut x = Mat::zeros(n, nrhs);
-    for f in 0..nrhs {
-        let b: Vec<c64> = (0..n).map(|i| rhs[i * nrhs + f]).collect();
-        let s = crate::gmres::solve_with(h.diagonal(), &|x: &[c64], y: &mut [c64]| h.apply(x, y), &b)?;
-        for (i, v) in s.x.into_iter().enumerate() {
-            x[(i, f)] = v;
-        }
-    }
-    Some(x)
+    let pc = BlockJacobi::new(asm.len(), h.diagonal_blocks().map(|(u, d)| (u, d.to_vec())))?;
+    gmres_solve(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| h.apply_many(xs, ys), &rhs, asm.fields().len())
 }
 
-/// GMRES for each right-hand side (`a` = `A` row-major, which the
-/// assembly's `Aᵀ` column-major layout is); `None` below
-/// [`ITERATIVE_MIN_UNKNOWNS`] or when any does not converge (the caller
-/// then factorises).
-fn iterative_solve(a: &[c64], n: usize, rhs: &[c64], nrhs: usize) -> Option<Mat<c64>> {
+/// GMRES on the dense system (`a` = `A` row-major, which the assembly's
+/// `Aᵀ` column-major layout is), preconditioned by its diagonal blocks on
+/// the leaves of the cluster tree of `asm` ([`HMatrix::leaves`]); `None`
+/// below [`ITERATIVE_MIN_UNKNOWNS`] or when any field does not converge
+/// (the caller then factorises).
+fn iterative_solve(asm: &Assembly<'_>, a: &[c64], rhs: &[c64]) -> Option<Mat<c64>> {
+    let n = asm.len();
     if n < ITERATIVE_MIN_UNKNOWNS {
         return None;
     }
-    let mut x = Mat::zeros(n, nrhs);
-    for f in 0..nrhs {
-        let b: Vec<c64> = (0..n).map(|i| rhs[i * nrhs + f]).collect();
-        let s = crate::gmres::solve(a, &b)?;
-        for (i, v) in s.x.into_iter().enumerate() {
-            x[(i, f)] = v;
-        }
-    }
-    Some(x)
+    let leaves = HMatrix::leaves(asm);
+    let block = |u: &[usize]| u.iter().flat_map(|&i| u.iter().map(move |&j| a[i * n + j])).collect();
+    let pc = BlockJacobi::new(n, leaves.iter().map(|u| (&u[..], block(u))))?;
+    gmres_solve(
+        &pc,
+        &|xs: &[&[c64]], ys: &mut [Vec<c64>]| crate::gmres::product(a, xs, ys),
+        rhs,
+        asm.fields().len(),
+    )
+}
+
+/// [`crate::gmres::solve_many`] on the right-hand sides `rhs` (row-major
+/// `n × nrhs`); the solutions as columns.
+fn gmres_solve(
+    pc: &BlockJacobi,
+    apply: &dyn Fn(&[&[c64]], &mut [Vec<c64>]),
+    rhs: &[c64],
+    nrhs: usize,
+) -> Option<Mat<c64>> {
+    let n = pc.len();
+    let bs: Vec<Vec<c64>> = (0..nrhs).map(|f| (0..n).map(|i| rhs[i * nrhs + f]).collect()).collect();
+    let bs: Vec<&[c64]> = bs.iter().map(Vec::as_slice).collect();
+    let solutions = crate::gmres::solve_many(pc, apply, &bs)?;
+    Some(Mat::from_fn(n, nrhs, |i, f| solutions[f].x[i]))
 }
 
 /// Solves `A x = b` given `at = Aᵀ` (column-major `n × n`, overwritten by
@@ -386,9 +398,11 @@ mod tests {
         let near = NearField::new(&mesh);
         let kern = Kernels::new(k);
         let alpha = c64::new(0.0, 1.0 / k);
+        let (clusters, fields) = (Clusters::identity(n), [q]);
+        let asm = Assembly::new(&mesh, &near, &clusters, &kern, alpha, &fields, true);
         let (mut at, mut rhs) =
-            crate::assembly::assemble(&mesh, &near, &Clusters::identity(n), &kern, alpha, &[q], true);
-        let it = iterative_solve(&at, n, &rhs, 1).expect("GMRES converges");
+            crate::assembly::assemble(&mesh, &near, &clusters, &kern, alpha, &fields, true);
+        let it = iterative_solve(&asm, &at, &rhs).expect("GMRES converges");
         let lu = lu_solve_transposed(&mut at, n, &mut rhs, 1).unwrap();
         let diff: f64 = (0..n).map(|i| (it[(i, 0)] - lu[(i, 0)]).norm_sqr()).sum::<f64>().sqrt();
         let size: f64 = (0..n).map(|i| lu[(i, 0)].norm_sqr()).sum::<f64>().sqrt();

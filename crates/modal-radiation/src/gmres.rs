@@ -22,6 +22,8 @@
 use faer::c64;
 use rayon::prelude::*;
 
+use crate::precond::BlockJacobi;
+
 /// Relative residual `‖b − A x‖ / ‖b‖` at which GMRES stops.
 pub const TOLERANCE: f64 = 1e-8;
 /// Krylov dimension before a restart.
@@ -29,17 +31,24 @@ pub const RESTART: usize = 60;
 /// Iterations (over all restarts) before giving up.
 pub const MAX_ITERATIONS: usize = 600;
 
-/// `y = A x` for `A` stored row-major (`a[i·n + j]`).
-fn product(a: &[c64], x: &[c64], y: &mut [c64]) {
-    let n = x.len();
-    y.par_iter_mut().enumerate().for_each(|(i, yi)| {
+/// `ys[v] = A xs[v]` for `A` stored row-major (`a[i·n + j]`): each row is
+/// read once for all the vectors, each entry a sequential sum in column
+/// order (the same bits for one vector as for several).
+pub fn product(a: &[c64], xs: &[&[c64]], ys: &mut [Vec<c64>]) {
+    let (nv, n) = (xs.len(), xs.first().map_or(0, |x| x.len()));
+    debug_assert_eq!(a.len(), n * n);
+    let mut rows = vec![c64::new(0.0, 0.0); n * nv];
+    rows.par_chunks_mut(nv.max(1)).enumerate().for_each(|(i, out)| {
         let row = &a[i * n..(i + 1) * n];
-        let mut s = c64::new(0.0, 0.0);
-        for (aij, xj) in row.iter().zip(x) {
-            s += aij * xj;
+        for (o, x) in out.iter_mut().zip(xs) {
+            *o = row.iter().zip(*x).fold(c64::new(0.0, 0.0), |s, (aij, xj)| s + aij * xj);
         }
-        *yi = s;
     });
+    for (i, out) in rows.chunks(nv.max(1)).enumerate() {
+        for (y, o) in ys.iter_mut().zip(out) {
+            y[i] = *o;
+        }
+    }
 }
 
 fn dot(a: &[c64], b: &[c64]) -> c64 {
@@ -62,114 +71,215 @@ pub struct Solution {
     pub residual: f64,
 }
 
-/// Solves `A x = b` (`a` row-major `n × n`) to [`TOLERANCE`]. `None` when
-/// it does not converge within [`MAX_ITERATIONS`] or meets a zero diagonal
-/// (the caller then factorises instead).
+/// Solves `A x = b` (`a` row-major `n × n`) to [`TOLERANCE`],
+/// preconditioned by the diagonal. `None` when it does not converge within
+/// [`MAX_ITERATIONS`] or meets a zero diagonal (the caller then factorises
+/// instead).
 pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
     let n = b.len();
     debug_assert_eq!(a.len(), n * n);
     let diagonal: Vec<c64> = (0..n).map(|i| a[i * n + i]).collect();
-    solve_with(&diagonal, &|x: &[c64], y: &mut [c64]| product(a, x, y), b)
+    let pc = BlockJacobi::diagonal(&diagonal)?;
+    solve_many(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| product(a, xs, ys), &[b])?.pop()
 }
 
-/// [`solve`] for an operator given by its diagonal and its product
-/// `apply(x, y)`: `y = A x` (for instance a compressed matrix,
-/// [`crate::hmatrix`]); `apply` must be deterministic for the result to be.
-pub fn solve_with(diagonal: &[c64], apply: &dyn Fn(&[c64], &mut [c64]), b: &[c64]) -> Option<Solution> {
-    let n = b.len();
-    let zero = c64::new(0.0, 0.0);
-    let inv_diag: Vec<c64> = diagonal.iter().map(|d| 1.0 / d).collect();
-    if inv_diag.iter().any(|d| !(d.re.is_finite() && d.im.is_finite())) {
-        return None;
-    }
-    let bnorm = norm(b);
-    if bnorm == 0.0 {
-        return Some(Solution { x: vec![zero; n], iterations: 0, residual: 0.0 });
-    }
-    // Preconditioned unknown u = D x; x = D⁻¹ u.
-    let mut u = vec![zero; n];
-    let mut r = b.to_vec();
-    let mut iterations = 0;
-    let mut scratch = vec![zero; n];
-    let m = RESTART.min(n);
-    while iterations < MAX_ITERATIONS {
-        let beta = norm(&r);
-        if beta <= TOLERANCE * bnorm {
+/// Solves `A x = b_f` for every right-hand side `bs[f]`, right-
+/// preconditioned by `pc` (`A M⁻¹ u = b`, `x = M⁻¹ u`), for an operator
+/// given by its product `apply(xs, ys)`: `ys[v] = A xs[v]` (for instance a
+/// compressed matrix, [`crate::hmatrix`]). The recurrences of the
+/// right-hand sides are independent but share each call of `apply`, so a
+/// memory-bound product streams `A` once for all of them. `apply` must
+/// give each vector the bits it would give it alone, and be deterministic,
+/// for every solution to equal the one-right-hand-side solve bit for bit.
+/// `None` when any does not converge.
+pub fn solve_many(
+    pc: &BlockJacobi,
+    apply: &dyn Fn(&[&[c64]], &mut [Vec<c64>]),
+    bs: &[&[c64]],
+) -> Option<Vec<Solution>> {
+    let mut recs: Vec<Recurrence<'_>> = bs.iter().map(|b| Recurrence::new(pc, b)).collect();
+    let mut products: Vec<Vec<c64>> = Vec::new();
+    loop {
+        let waiting: Vec<usize> = (0..recs.len()).filter(|&f| recs[f].done.is_none()).collect();
+        if waiting.is_empty() {
             break;
         }
-        let mut v: Vec<Vec<c64>> = Vec::with_capacity(m + 1);
-        v.push(r.iter().map(|z| z / beta).collect());
-        let mut h = vec![vec![zero; m]; m + 1];
-        let (mut cs, mut sn) = (vec![0.0f64; m], vec![zero; m]);
-        let mut g = vec![zero; m + 1];
-        g[0] = c64::new(beta, 0.0);
-        let mut steps = 0;
-        for j in 0..m {
-            for (s, (vj, d)) in scratch.iter_mut().zip(v[j].iter().zip(&inv_diag)) {
-                *s = vj * d;
-            }
-            let mut w = vec![zero; n];
-            apply(&scratch, &mut w);
-            for (i, vi) in v.iter().enumerate() {
-                let hij = dot(vi, &w);
-                h[i][j] = hij;
-                for (wk, vk) in w.iter_mut().zip(vi) {
-                    *wk -= hij * vk;
-                }
-            }
-            let hn = norm(&w);
-            h[j + 1][j] = c64::new(hn, 0.0);
-            // Apply the previous rotations to column j, then a new one.
-            for i in 0..j {
-                let t = cs[i] * h[i][j] + sn[i] * h[i + 1][j];
-                h[i + 1][j] = -sn[i].conj() * h[i][j] + cs[i] * h[i + 1][j];
-                h[i][j] = t;
-            }
-            let (c, s) = givens(h[j][j], h[j + 1][j]);
-            cs[j] = c;
-            sn[j] = s;
-            h[j][j] = c * h[j][j] + s * h[j + 1][j];
-            h[j + 1][j] = zero;
-            g[j + 1] = -s.conj() * g[j];
-            g[j] *= c;
-            steps = j + 1;
-            iterations += 1;
-            if g[j + 1].norm() <= TOLERANCE * bnorm || hn == 0.0 || iterations >= MAX_ITERATIONS {
-                break;
-            }
-            v.push(w.iter().map(|z| z / hn).collect());
+        let inputs: Vec<&[c64]> = waiting.iter().map(|&f| &recs[f].input[..]).collect();
+        products.resize_with(waiting.len(), || vec![c64::new(0.0, 0.0); pc.len()]);
+        apply(&inputs, &mut products[..waiting.len()]);
+        for (&f, w) in waiting.iter().zip(&products) {
+            recs[f].take(w);
         }
-        // Back substitution H y = g, then u += V y.
-        let mut y = vec![zero; steps];
+    }
+    recs.into_iter().map(|r| r.done.flatten()).collect()
+}
+
+/// What a [`Recurrence`] waits for the product `A · input` of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Waiting {
+    /// `M⁻¹ v_j`: Arnoldi step `j`.
+    Arnoldi,
+    /// `M⁻¹ u`: the true residual after a cycle.
+    Residual,
+}
+
+/// The restarted GMRES of one right-hand side as a state machine: it
+/// names the vector it needs multiplied (`input`) and continues when
+/// given the product ([`Recurrence::take`]).
+struct Recurrence<'a> {
+    pc: &'a BlockJacobi,
+    b: &'a [c64],
+    bnorm: f64,
+    /// Preconditioned unknown, `x = M⁻¹ u`.
+    u: Vec<c64>,
+    r: Vec<c64>,
+    /// Arnoldi basis `V`, Hessenberg columns `H̄` (rotated), rotations, `g`.
+    v: Vec<Vec<c64>>,
+    h: Vec<Vec<c64>>,
+    cs: Vec<f64>,
+    sn: Vec<c64>,
+    g: Vec<c64>,
+    iterations: usize,
+    input: Vec<c64>,
+    waiting: Waiting,
+    /// `Some(result)` once finished.
+    done: Option<Option<Solution>>,
+}
+
+impl<'a> Recurrence<'a> {
+    fn new(pc: &'a BlockJacobi, b: &'a [c64]) -> Recurrence<'a> {
+        let n = b.len();
+        assert_eq!(n, pc.len(), "right-hand side and preconditioner sizes differ");
+        let zero = c64::new(0.0, 0.0);
+        let mut rec = Recurrence {
+            pc,
+            b,
+            bnorm: norm(b),
+            u: vec![zero; n],
+            r: b.to_vec(),
+            v: Vec::new(),
+            h: Vec::new(),
+            cs: Vec::new(),
+            sn: Vec::new(),
+            g: Vec::new(),
+            iterations: 0,
+            input: vec![zero; n],
+            waiting: Waiting::Arnoldi,
+            done: None,
+        };
+        if rec.bnorm == 0.0 {
+            rec.done = Some(Some(Solution { x: vec![zero; n], iterations: 0, residual: 0.0 }));
+        } else {
+            rec.start_cycle();
+        }
+        rec
+    }
+
+    /// A new Krylov cycle from the residual `r`, or the end.
+    fn start_cycle(&mut self) {
+        let beta = norm(&self.r);
+        if beta <= TOLERANCE * self.bnorm || self.iterations >= MAX_ITERATIONS {
+            self.finish();
+            return;
+        }
+        let zero = c64::new(0.0, 0.0);
+        let m = RESTART.min(self.b.len());
+        self.v.clear();
+        self.v.push(self.r.iter().map(|z| z / beta).collect());
+        self.h = vec![vec![zero; m]; m + 1];
+        self.cs = vec![0.0; m];
+        self.sn = vec![zero; m];
+        self.g = vec![zero; m + 1];
+        self.g[0] = c64::new(beta, 0.0);
+        self.pc.solve(&self.v[0], &mut self.input);
+        self.waiting = Waiting::Arnoldi;
+    }
+
+    /// Continues with `w = A · input`.
+    fn take(&mut self, w: &[c64]) {
+        match self.waiting {
+            Waiting::Arnoldi => self.arnoldi(w.to_vec()),
+            Waiting::Residual => {
+                for (ri, (bi, ai)) in self.r.iter_mut().zip(self.b.iter().zip(w)) {
+                    *ri = bi - ai;
+                }
+                self.start_cycle();
+            }
+        }
+    }
+
+    /// Arnoldi step `j = v.len() − 1` with `w = A M⁻¹ v_j`: orthogonalise
+    /// (modified Gram–Schmidt), rotate the new column of `H̄`, and either
+    /// continue the cycle or close it.
+    fn arnoldi(&mut self, mut w: Vec<c64>) {
+        let zero = c64::new(0.0, 0.0);
+        let j = self.v.len() - 1;
+        let m = self.cs.len();
+        for (i, vi) in self.v.iter().enumerate() {
+            let hij = dot(vi, &w);
+            self.h[i][j] = hij;
+            for (wk, vk) in w.iter_mut().zip(vi) {
+                *wk -= hij * vk;
+            }
+        }
+        let hn = norm(&w);
+        let h = &mut self.h;
+        h[j + 1][j] = c64::new(hn, 0.0);
+        // Apply the previous rotations to column j, then a new one.
+        for i in 0..j {
+            let t = self.cs[i] * h[i][j] + self.sn[i] * h[i + 1][j];
+            h[i + 1][j] = -self.sn[i].conj() * h[i][j] + self.cs[i] * h[i + 1][j];
+            h[i][j] = t;
+        }
+        let (c, s) = givens(h[j][j], h[j + 1][j]);
+        self.cs[j] = c;
+        self.sn[j] = s;
+        h[j][j] = c * h[j][j] + s * h[j + 1][j];
+        h[j + 1][j] = zero;
+        self.g[j + 1] = -s.conj() * self.g[j];
+        self.g[j] *= c;
+        self.iterations += 1;
+        let converged = self.g[j + 1].norm() <= TOLERANCE * self.bnorm;
+        if converged || hn == 0.0 || self.iterations >= MAX_ITERATIONS || j + 1 == m {
+            self.close_cycle(j + 1);
+        } else {
+            self.v.push(w.iter().map(|z| z / hn).collect());
+            self.pc.solve(&self.v[j + 1], &mut self.input);
+        }
+    }
+
+    /// Back substitution `H y = g` over `steps` columns, `u += V y`, then
+    /// asks for `A M⁻¹ u` (the true residual).
+    fn close_cycle(&mut self, steps: usize) {
+        let mut y = vec![c64::new(0.0, 0.0); steps];
         for i in (0..steps).rev() {
-            let mut s = g[i];
+            let mut s = self.g[i];
             for k in i + 1..steps {
-                s -= h[i][k] * y[k];
+                s -= self.h[i][k] * y[k];
             }
-            if h[i][i].norm() == 0.0 {
-                return None;
+            if self.h[i][i].norm() == 0.0 {
+                self.done = Some(None);
+                return;
             }
-            y[i] = s / h[i][i];
+            y[i] = s / self.h[i][i];
         }
         for (k, yk) in y.iter().enumerate() {
-            for (ui, vi) in u.iter_mut().zip(&v[k]) {
+            for (ui, vi) in self.u.iter_mut().zip(&self.v[k]) {
                 *ui += yk * vi;
             }
         }
-        // True residual r = b − A D⁻¹ u.
-        for (s, (ui, d)) in scratch.iter_mut().zip(u.iter().zip(&inv_diag)) {
-            *s = ui * d;
-        }
-        let mut au = vec![zero; n];
-        apply(&scratch, &mut au);
-        for (ri, (bi, ai)) in r.iter_mut().zip(b.iter().zip(&au)) {
-            *ri = bi - ai;
-        }
+        self.pc.solve(&self.u, &mut self.input);
+        self.waiting = Waiting::Residual;
     }
-    let residual = norm(&r) / bnorm;
-    let x: Vec<c64> = u.iter().zip(&inv_diag).map(|(ui, d)| ui * d).collect();
-    let finite = x.iter().all(|z| z.re.is_finite() && z.im.is_finite());
-    (residual <= TOLERANCE && finite).then_some(Solution { x, iterations, residual })
+
+    fn finish(&mut self) {
+        let residual = norm(&self.r) / self.bnorm;
+        let mut x = vec![c64::new(0.0, 0.0); self.b.len()];
+        self.pc.solve(&self.u, &mut x);
+        let finite = x.iter().all(|z| z.re.is_finite() && z.im.is_finite());
+        let ok = residual <= TOLERANCE && finite;
+        self.done = Some(ok.then_some(Solution { x, iterations: self.iterations, residual }));
+    }
 }
 
 /// Rotation `(c, s)`, `c` real, with `[c s; −s̄ c] [a; b] = [ρ; 0]`.
@@ -191,6 +301,13 @@ fn givens(a: c64, b: c64) -> (f64, c64) {
 mod tests {
     use super::*;
 
+    /// `y = A x`.
+    fn mul(a: &[c64], x: &[c64]) -> Vec<c64> {
+        let mut y = vec![vec![c64::new(0.0, 0.0); x.len()]];
+        product(a, &[x], &mut y);
+        y.remove(0)
+    }
+
     /// A diagonally dominant complex matrix with a smooth off-diagonal part
     /// (the shape of a boundary-element matrix) and a known solution.
     fn system(n: usize) -> (Vec<c64>, Vec<c64>) {
@@ -210,14 +327,12 @@ mod tests {
     fn recovers_a_known_solution_and_its_residual_is_true() {
         let n = 150;
         let (a, x) = system(n);
-        let mut b = vec![c64::new(0.0, 0.0); n];
-        product(&a, &x, &mut b);
+        let b = mul(&a, &x);
         let s = solve(&a, &b).expect("converges");
         let err = s.x.iter().zip(&x).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&x);
         assert!(err < 1e-6, "error {err}");
         assert!(s.residual <= TOLERANCE && s.iterations > 0 && s.iterations < n);
-        let mut ax = vec![c64::new(0.0, 0.0); n];
-        product(&a, &s.x, &mut ax);
+        let ax = mul(&a, &s.x);
         let res = ax.iter().zip(&b).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&b);
         assert!((res - s.residual).abs() < 1e-12, "{res} vs {}", s.residual);
     }
@@ -234,8 +349,7 @@ mod tests {
             a[i * n + (i + 1) % n] = c64::new(0.9, 0.0);
         }
         let x: Vec<c64> = (0..n).map(|i| c64::new(1.0 + (i as f64).sin(), i as f64 * 0.01)).collect();
-        let mut b = vec![c64::new(0.0, 0.0); n];
-        product(&a, &x, &mut b);
+        let b = mul(&a, &x);
         let s = solve(&a, &b).expect("converges");
         assert!(s.iterations > RESTART, "{} iterations", s.iterations);
         let err = s.x.iter().zip(&x).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&x);
