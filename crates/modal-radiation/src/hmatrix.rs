@@ -341,9 +341,9 @@ impl HMatrix {
     }
 
     /// `ys[v] = A xs[v]` for several vectors in one pass over the stored
-    /// blocks (the product is memory-bound: each block is read once for
-    /// all of them). Each vector gets the same operations in the same
-    /// order as [`HMatrix::apply`] gives it alone: the same bits.
+    /// blocks (each block is read once for all of them), every row sum by
+    /// [`crate::gmres::row_dot`]: each vector gets the same bits as it
+    /// would alone, and [`HMatrix::apply`]'s up to rounding.
     pub(crate) fn apply_many(&self, xs: &[&[c64]], ys: &mut [Vec<c64>]) {
         let zero = c64::new(0.0, 0.0);
         let nv = xs.len();
@@ -362,14 +362,14 @@ impl HMatrix {
                         Data::Dense(d) => {
                             for (o, row) in out.chunks_mut(nv).zip(d.chunks(c1 - c0)) {
                                 for (ov, x) in o.iter_mut().zip(&xp) {
-                                    *ov += dot(row, &x[c0..c1]);
+                                    *ov += crate::gmres::row_dot(row, &x[c0..c1]);
                                 }
                             }
                         }
                         Data::LowRank { u, w } => {
                             for (uk, wk) in u.iter().zip(w) {
                                 for (tv, x) in t.iter_mut().zip(&xp) {
-                                    *tv = dot(wk, &x[c0..c1]);
+                                    *tv = crate::gmres::row_dot(wk, &x[c0..c1]);
                                 }
                                 for (o, v) in out.chunks_mut(nv).zip(uk) {
                                     for (ov, tv) in o.iter_mut().zip(&t) {
