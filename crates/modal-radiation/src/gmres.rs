@@ -51,27 +51,38 @@ pub fn product(a: &[c64], xs: &[&[c64]], ys: &mut [Vec<c64>]) {
     }
 }
 
-/// `Σ_j a_j x_j` (no conjugate) summed in four interleaved partial sums,
-/// `s_r = Σ_{j ≡ r mod 4} a_j x_j`, joined as `(s₀ + s₁) + (s₂ + s₃)`.
-/// A sequential sum is one chain of dependent additions, so its speed is
-/// the adder's latency (about 4 cycles an entry); four independent chains
-/// fill the pipeline. The order is fixed by `j` alone: deterministic, and
-/// the same for any thread count.
+/// `Σ_j a_j x_j` (no conjugate) in a fixed order made for throughput.
+/// With `a_j = α_j + iβ_j`, `x_j = ξ_j + iη_j` it sums the four real
+/// products `α_j ξ_j`, `β_j ξ_j`, `α_j η_j`, `β_j η_j` apart, each in four
+/// interleaved partial sums (`j mod 4`), and forms
+/// `Re = Σ αξ − Σ βη`, `Im = Σ βξ + Σ αη` at the end. A sequential complex
+/// sum is a chain of dependent additions whose speed is the adder's
+/// latency; here 16 independent chains, in pairs `(αξ, βξ)` and
+/// `(αη, βη)` that map onto two-lane vector instructions, fill the
+/// pipeline. The order depends on `j` alone: deterministic, the same for
+/// any thread count.
 pub(crate) fn row_dot(a: &[c64], x: &[c64]) -> c64 {
     debug_assert_eq!(a.len(), x.len());
-    let zero = c64::new(0.0, 0.0);
-    let mut s = [zero; 4];
+    // p[2r..2r+2] = (Σ αξ, Σ βξ), q[2r..2r+2] = (Σ αη, Σ βη) over j ≡ r mod 4.
+    let (mut p, mut q) = ([0.0f64; 8], [0.0f64; 8]);
     let (a4, x4) = (a.chunks_exact(4), x.chunks_exact(4));
     let (ar, xr) = (a4.remainder(), x4.remainder());
     for (aq, xq) in a4.zip(x4) {
         for r in 0..4 {
-            s[r] += aq[r] * xq[r];
+            p[2 * r] += aq[r].re * xq[r].re;
+            p[2 * r + 1] += aq[r].im * xq[r].re;
+            q[2 * r] += aq[r].re * xq[r].im;
+            q[2 * r + 1] += aq[r].im * xq[r].im;
         }
     }
     for (r, (ai, xi)) in ar.iter().zip(xr).enumerate() {
-        s[r] += ai * xi;
+        p[2 * r] += ai.re * xi.re;
+        p[2 * r + 1] += ai.im * xi.re;
+        q[2 * r] += ai.re * xi.im;
+        q[2 * r + 1] += ai.im * xi.im;
     }
-    (s[0] + s[1]) + (s[2] + s[3])
+    let sum = |v: &[f64; 8], o: usize| (v[o] + v[2 + o]) + (v[4 + o] + v[6 + o]);
+    c64::new(sum(&p, 0) - sum(&q, 1), sum(&p, 1) + sum(&q, 0))
 }
 
 fn dot(a: &[c64], b: &[c64]) -> c64 {
