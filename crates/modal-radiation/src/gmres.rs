@@ -1,5 +1,5 @@
 //! Restarted GMRES for the Burton–Miller system `A x = b`, dense or
-//! compressed ([`solve_with`] takes any product `x ↦ A x`).
+//! compressed ([`solve_many`] takes any product `x ↦ A x`).
 //!
 //! GMRES(m) minimises `‖b − A x‖₂` over `x₀ + K_m(A, r₀)`,
 //! `K_m = span{r₀, A r₀, …, A^{m−1} r₀}`: Arnoldi with modified
@@ -7,17 +7,22 @@
 //! `(m+1) × m` Hessenberg `H̄_m` to triangular form, and the residual norm
 //! of the least-squares problem `min ‖β e₁ − H̄_m y‖` is the last rotated
 //! entry, known at every step without forming `x`. The system is
-//! right-preconditioned by its diagonal (`A D⁻¹ (D x) = b`), which evens
-//! the hypersingular operator's `1/h` scale across panel sizes.
+//! right-preconditioned, `A M⁻¹ u = b`, `x = M⁻¹ u`, by its diagonal or
+//! its diagonal blocks ([`crate::precond`]): the residual GMRES minimises
+//! stays the true one.
 //!
-//! Cost: one dense product per iteration (`n²` complex multiply-adds),
-//! against `8/3 n³` flops for the LU it replaces: the Burton–Miller
-//! operator is well conditioned at every frequency (no interior
-//! resonance), so tens of iterations reach `10⁻⁸`.
+//! Cost: one product per iteration (`n²` complex multiply-adds dense,
+//! the stored entries compressed), against `8/3 n³` flops for the LU it
+//! replaces: the Burton–Miller operator is well conditioned at every
+//! frequency (no interior resonance), so tens of iterations reach
+//! [`TOLERANCE`]. The right-hand sides of one system (a degenerate pair of
+//! modes) run side by side and share each product: the matrix is read
+//! from memory once for all of them.
 //!
-//! Determinism: the product runs rows in parallel, each row a sequential
-//! sum in a fixed order, and every reduction (dot products, norms) is
-//! sequential, so the iterates are bit-identical for any thread count.
+//! Determinism: the product runs rows in parallel, each row sum in a fixed
+//! order ([`row_dot`]), and every reduction (dot products, norms) is
+//! sequential, so the iterates are bit-identical for any thread count, and
+//! each right-hand side's for any number of others beside it.
 
 use faer::c64;
 use rayon::prelude::*;
@@ -25,15 +30,24 @@ use rayon::prelude::*;
 use crate::precond::BlockJacobi;
 
 /// Relative residual `‖b − A x‖ / ‖b‖` at which GMRES stops.
-pub const TOLERANCE: f64 = 1e-8;
+///
+/// The solution's relative error is at most `cond(A) · TOLERANCE`, and a
+/// level error of `δ` relative is `20 log₁₀(1 + δ)` ≈ `8.7 δ` dB. On the
+/// demo glass bowl (13 modes ≤ 12.1 kHz, 2 209–5 707 unknowns, 8 points
+/// at 0.15 m; `modal radiation bowl.bank --max-freq 12100 --json
+/// --point …`, against 10⁻⁸) the largest change was 0.0004 dB at points
+/// and < 0.0001 dB in power at 10⁻⁶, 0.0059 dB at points at 10⁻⁵: 10⁻⁶
+/// keeps the levels 25× inside the 0.01 dB we allow ourselves and 10⁴×
+/// inside the cross-check's 1 dB, with 30 % fewer iterations than 10⁻⁸.
+pub const TOLERANCE: f64 = 1e-6;
 /// Krylov dimension before a restart.
 pub const RESTART: usize = 60;
 /// Iterations (over all restarts) before giving up.
 pub const MAX_ITERATIONS: usize = 600;
 
 /// `ys[v] = A xs[v]` for `A` stored row-major (`a[i·n + j]`): each row is
-/// read once for all the vectors, each entry a sequential sum in column
-/// order (the same bits for one vector as for several).
+/// read once for all the vectors, each entry a [`row_dot`] (the same bits
+/// for one vector as for several).
 pub fn product(a: &[c64], xs: &[&[c64]], ys: &mut [Vec<c64>]) {
     let (nv, n) = (xs.len(), xs.first().map_or(0, |x| x.len()));
     debug_assert_eq!(a.len(), n * n);
@@ -93,6 +107,10 @@ fn norm(a: &[c64]) -> f64 {
     a.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt()
 }
 
+/// A product with several vectors at once: `apply(xs, ys)` sets
+/// `ys[v] = A xs[v]`.
+pub type MultiProduct<'a> = dyn Fn(&[&[c64]], &mut [Vec<c64>]) + 'a;
+
 /// Outcome of one solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solution {
@@ -126,11 +144,7 @@ pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
 /// give each vector the bits it would give it alone, and be deterministic,
 /// for every solution to equal the one-right-hand-side solve bit for bit.
 /// `None` when any does not converge.
-pub fn solve_many(
-    pc: &BlockJacobi,
-    apply: &dyn Fn(&[&[c64]], &mut [Vec<c64>]),
-    bs: &[&[c64]],
-) -> Option<Vec<Solution>> {
+pub fn solve_many(pc: &BlockJacobi, apply: &MultiProduct<'_>, bs: &[&[c64]]) -> Option<Vec<Solution>> {
     let mut recs: Vec<Recurrence<'_>> = bs.iter().map(|b| Recurrence::new(pc, b)).collect();
     let mut products: Vec<Vec<c64>> = Vec::new();
     loop {
@@ -287,10 +301,7 @@ impl<'a> Recurrence<'a> {
     fn close_cycle(&mut self, steps: usize) {
         let mut y = vec![c64::new(0.0, 0.0); steps];
         for i in (0..steps).rev() {
-            let mut s = self.g[i];
-            for k in i + 1..steps {
-                s -= self.h[i][k] * y[k];
-            }
+            let s = (i + 1..steps).fold(self.g[i], |s, k| s - self.h[i][k] * y[k]);
             if self.h[i][i].norm() == 0.0 {
                 self.done = Some(None);
                 return;
@@ -364,7 +375,8 @@ mod tests {
         let b = mul(&a, &x);
         let s = solve(&a, &b).expect("converges");
         let err = s.x.iter().zip(&x).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&x);
-        assert!(err < 1e-6, "error {err}");
+        // cond(A) < 10 for this diagonally dominant matrix: error ≤ cond · tolerance.
+        assert!(err < 10.0 * TOLERANCE, "error {err}");
         assert!(s.residual <= TOLERANCE && s.iterations > 0 && s.iterations < n);
         let ax = mul(&a, &s.x);
         let res = ax.iter().zip(&b).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&b);
@@ -387,12 +399,74 @@ mod tests {
         let s = solve(&a, &b).expect("converges");
         assert!(s.iterations > RESTART, "{} iterations", s.iterations);
         let err = s.x.iter().zip(&x).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&x);
-        assert!(err < 1e-6, "error {err} after {} iterations", s.iterations);
+        // cond(A) = 1.9/0.1 = 19: error ≤ cond · tolerance.
+        assert!(err < 19.0 * TOLERANCE, "error {err} after {} iterations", s.iterations);
     }
 
     #[test]
     fn singular_or_zero_diagonal_gives_none() {
         let a = vec![c64::new(0.0, 0.0); 4];
         assert!(solve(&a, &[c64::new(1.0, 0.0), c64::new(0.0, 0.0)]).is_none());
+    }
+
+    /// Two right-hand sides of [`system`] solved together and each alone.
+    fn together_and_alone(threads: usize) -> (Vec<Solution>, Vec<Solution>) {
+        let n = 300;
+        let (a, x) = system(n);
+        let b1 = mul(&a, &x);
+        let b2: Vec<c64> =
+            b1.iter().enumerate().map(|(i, z)| z * c64::new(1.0, 0.1 * i as f64).sqrt()).collect();
+        let diagonal: Vec<c64> = (0..n).map(|i| a[i * n + i]).collect();
+        let pc = BlockJacobi::diagonal(&diagonal).unwrap();
+        let apply = |xs: &[&[c64]], ys: &mut [Vec<c64>]| product(&a, xs, ys);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let together = solve_many(&pc, &apply, &[&b1, &b2]).expect("converges");
+            let alone = [&b1, &b2].iter().map(|b| solve_many(&pc, &apply, &[b]).unwrap().remove(0)).collect();
+            (together, alone)
+        })
+    }
+
+    #[test]
+    fn right_hand_sides_solved_together_give_the_bits_of_each_alone_on_any_thread_count() {
+        let (together, alone) = together_and_alone(1);
+        assert_ne!(together[0].iterations, 0);
+        assert_eq!(together, alone);
+        assert_eq!(together_and_alone(3), (together, alone));
+    }
+
+    #[test]
+    fn the_exact_block_preconditioner_of_a_block_diagonal_matrix_solves_it_in_one_iteration() {
+        // Three blocks on interleaved unknowns {0, 3, 6, …}, {1, 4, …}, {2, 5, …}.
+        let n = 30;
+        let (full, x) = system(n);
+        let mut a = vec![c64::new(0.0, 0.0); n * n];
+        for i in 0..n {
+            for j in (i % 3..n).step_by(3) {
+                a[i * n + j] = full[i * n + j];
+            }
+        }
+        let sets: Vec<Vec<usize>> = (0..3).map(|r| (r..n).step_by(3).collect()).collect();
+        let a_ref = &a;
+        let block = |u: &[usize]| u.iter().flat_map(|&i| u.iter().map(move |&j| a_ref[i * n + j])).collect();
+        let pc = BlockJacobi::new(n, sets.iter().map(|u| (&u[..], block(u)))).unwrap();
+        let b = mul(&a, &x);
+        let s = solve_many(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| product(&a, xs, ys), &[&b]).unwrap();
+        assert_eq!(s[0].iterations, 1);
+        let err = s[0].x.iter().zip(&x).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>().sqrt() / norm(&x);
+        assert!(err < 1e-12, "error {err}");
+        // The diagonal alone needs more.
+        let d = solve(&a, &b).unwrap();
+        assert!(d.iterations > 1, "{} iterations", d.iterations);
+    }
+
+    #[test]
+    fn row_dot_is_the_complex_sum() {
+        for len in [0, 1, 3, 4, 5, 17] {
+            let a: Vec<c64> = (0..len).map(|j| c64::new(j as f64 + 0.5, 1.0 - j as f64)).collect();
+            let x: Vec<c64> = (0..len).map(|j| c64::new((j as f64).cos(), 0.25 * j as f64)).collect();
+            let exact: c64 = a.iter().zip(&x).map(|(p, q)| p * q).sum();
+            assert!((row_dot(&a, &x) - exact).norm() <= 1e-13 * (1.0 + exact.norm()), "length {len}");
+        }
     }
 }
