@@ -36,10 +36,11 @@ use crate::precond::BlockJacobi;
 /// demo glass bowl (13 modes ≤ 12.1 kHz, 2 209–5 707 unknowns, 8 points
 /// at 0.15 m; `modal radiation bowl.bank --max-freq 12100 --json
 /// --point …`, against 10⁻⁸) the largest change was 0.0004 dB at points
-/// and < 0.0001 dB in power at 10⁻⁶, 0.0059 dB at points at 10⁻⁵: 10⁻⁶
-/// keeps the levels 25× inside the 0.01 dB we allow ourselves and 10⁴×
-/// inside the cross-check's 1 dB, with 30 % fewer iterations than 10⁻⁸.
-pub const TOLERANCE: f64 = 1e-6;
+/// within 20 dB of a mode's loudest and < 0.0001 dB in power at 10⁻⁶,
+/// 0.0059 dB at 10⁻⁵; 10⁻⁶ takes 30 % fewer iterations than 10⁻⁸. The
+/// levels would allow 10⁻⁶, but the sphere tests assert mirror symmetry of
+/// the pressure to 10⁻⁹ relative, which needs the solve that tight.
+pub const TOLERANCE: f64 = 1e-8;
 /// Krylov dimension before a restart.
 pub const RESTART: usize = 60;
 /// Iterations (over all restarts) before giving up.
