@@ -333,6 +333,74 @@ impl HMatrix {
     }
 }
 
+impl HMatrix {
+    /// The diagonal blocks `A_ττ` of the leaves `τ` (always dense: a leaf
+    /// is never admissible with itself) as (unknowns, row-major entries).
+    pub(crate) fn diagonal_blocks(&self) -> impl Iterator<Item = (&[usize], &[c64])> {
+        self.blocks.iter().filter(|b| b.rows == b.cols).filter_map(|b| match &b.data {
+            Data::Dense(d) => Some((&self.perm[b.rows.0..b.rows.1], &d[..])),
+            Data::LowRank { .. } => None,
+        })
+    }
+
+    /// `ys[v] = A xs[v]` for several vectors in one pass over the stored
+    /// blocks (each block is read once for all of them), every row sum by
+    /// [`crate::gmres::row_dot`]: each vector gets the same bits as it
+    /// would alone, and [`HMatrix::apply`]'s up to rounding.
+    pub(crate) fn apply_many(&self, xs: &[&[c64]], ys: &mut [Vec<c64>]) {
+        let zero = c64::new(0.0, 0.0);
+        let nv = xs.len();
+        let xp: Vec<Vec<c64>> = xs.iter().map(|x| self.perm.iter().map(|&c| x[c]).collect()).collect();
+        let parts: Vec<Vec<c64>> = self
+            .groups
+            .par_iter()
+            .map(|g| {
+                let rows = self.blocks[g[0]].rows;
+                // out[i·nv + v]: row i of the node, vector v.
+                let mut out = vec![zero; (rows.1 - rows.0) * nv];
+                let mut t = vec![zero; nv];
+                for b in g.iter().map(|&b| &self.blocks[b]) {
+                    let (c0, c1) = b.cols;
+                    match &b.data {
+                        Data::Dense(d) => {
+                            for (o, row) in out.chunks_mut(nv).zip(d.chunks(c1 - c0)) {
+                                for (ov, x) in o.iter_mut().zip(&xp) {
+                                    *ov += crate::gmres::row_dot(row, &x[c0..c1]);
+                                }
+                            }
+                        }
+                        Data::LowRank { u, w } => {
+                            for (uk, wk) in u.iter().zip(w) {
+                                for (tv, x) in t.iter_mut().zip(&xp) {
+                                    *tv = crate::gmres::row_dot(wk, &x[c0..c1]);
+                                }
+                                for (o, v) in out.chunks_mut(nv).zip(uk) {
+                                    for (ov, tv) in o.iter_mut().zip(&t) {
+                                        *ov += v * tv;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut yp = vec![zero; self.len() * nv];
+        for (g, part) in self.groups.iter().zip(parts) {
+            let rows = self.blocks[g[0]].rows;
+            for (o, v) in yp[rows.0 * nv..rows.1 * nv].iter_mut().zip(part) {
+                *o += v;
+            }
+        }
+        for (p, &c) in self.perm.iter().enumerate() {
+            for (y, v) in ys.iter_mut().zip(&yp[p * nv..(p + 1) * nv]) {
+                y[c] = *v;
+            }
+        }
+    }
+}
+
 /// `Σ a_i b_i` in order.
 fn dot(a: &[c64], b: &[c64]) -> c64 {
     a.iter().zip(b).fold(c64::new(0.0, 0.0), |s, (x, y)| s + x * y)

@@ -22,6 +22,7 @@
 //! - [`near`]: the geometry-only part of the near panel integrals, once per mesh ([`Discretization`]);
 //! - [`multipole::fit`]: the far-field representation;
 //! - [`radiate_modes`]: every requested mode of a `modal_bank::ModeBank`;
+//! - [`precond`]: the block-Jacobi preconditioner of the GMRES solves;
 //! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
@@ -44,6 +45,7 @@ pub mod modes;
 pub mod multipole;
 pub mod near;
 pub mod normals;
+pub mod precond;
 pub mod quadrature;
 pub mod special;
 
