@@ -26,9 +26,9 @@
 //! dense complex LU with partial pivoting (faer, sequential, so
 //! the result does not depend on the thread count) below
 //! [`ITERATIVE_MIN_UNKNOWNS`] unknowns, restarted GMRES ([`crate::gmres`],
-//! preconditioned by the diagonal, or on the compressed matrix by the
-//! diagonal blocks of the cluster tree's leaves, [`crate::precond`]; all
-//! fields at once; LU if it fails to converge) above. Rows are assembled
+//! preconditioned by the diagonal blocks of the cluster tree's leaves,
+//! [`crate::precond`]; all fields at once; LU if it fails to converge)
+//! above. Rows are assembled
 //! independently in parallel (rayon), each by one thread in a fixed order:
 //! bit-identical across thread counts.
 
@@ -278,18 +278,18 @@ fn compressed_solve(asm: &Assembly<'_>) -> Option<Mat<c64>> {
 }
 
 /// GMRES on the dense system (`a` = `A` row-major, which the assembly's
-/// `Aᵀ` column-major layout is), preconditioned by its diagonal; `None`
+/// `Aᵀ` column-major layout is), preconditioned by its diagonal blocks on
+/// the leaves of the cluster tree of `asm` ([`HMatrix::leaves`]); `None`
 /// below [`ITERATIVE_MIN_UNKNOWNS`] or when any field does not converge
-/// (the caller then factorises). The diagonal, unlike the tree's blocks,
-/// commutes with any symmetry of the mesh, so the iterates keep the
-/// symmetries of the solution to rounding, not only to the tolerance
-/// (`tests/sphere.rs` asserts mirror symmetry to 1e-9 at 1 280 unknowns).
+/// (the caller then factorises).
 fn iterative_solve(asm: &Assembly<'_>, a: &[c64], rhs: &[c64]) -> Option<Mat<c64>> {
     let n = asm.len();
     if n < ITERATIVE_MIN_UNKNOWNS {
         return None;
     }
-    let pc = BlockJacobi::diagonal(&(0..n).map(|i| a[i * n + i]).collect::<Vec<_>>())?;
+    let leaves = HMatrix::leaves(asm);
+    let block = |u: &[usize]| u.iter().flat_map(|&i| u.iter().map(move |&j| a[i * n + j])).collect();
+    let pc = BlockJacobi::new(n, leaves.iter().map(|u| (&u[..], block(u))))?;
     gmres_solve(
         &pc,
         &|xs: &[&[c64]], ys: &mut [Vec<c64>]| crate::gmres::product(a, xs, ys),

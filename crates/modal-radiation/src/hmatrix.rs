@@ -334,6 +334,19 @@ impl HMatrix {
 }
 
 impl HMatrix {
+    /// The unknowns of each leaf of the cluster tree of `asm` (module doc),
+    /// the leaves in tree order: blocks of nearby unknowns for
+    /// [`crate::precond::BlockJacobi`] on a dense system.
+    pub(crate) fn leaves(asm: &Assembly<'_>) -> Vec<Vec<usize>> {
+        let bounds: Vec<Bounds> = (0..asm.len()).map(|c| asm.bounds(c)).collect();
+        let tree = ClusterTree::new(&bounds);
+        tree.nodes
+            .iter()
+            .filter(|nd| nd.children.is_none())
+            .map(|nd| tree.perm[nd.start..nd.end].to_vec())
+            .collect()
+    }
+
     /// The diagonal blocks `A_ττ` of the leaves `τ` (always dense: a leaf
     /// is never admissible with itself) as (unknowns, row-major entries).
     pub(crate) fn diagonal_blocks(&self) -> impl Iterator<Item = (&[usize], &[c64])> {

@@ -194,8 +194,10 @@ fn mirror_symmetric_fields_give_mirror_symmetric_pressure() {
     let s = solve_one(&mesh, 1.5, v, Formulation::BurtonMiller);
     let (x, mx, mz) = ([0.2, 0.13, 0.17], [-0.2, 0.13, 0.17], [0.2, 0.13, -0.17]);
     let [p, px, pz] = [x, mx, mz].map(|q| s.pressure_at(&mesh, q).unwrap());
-    assert!((p - px).norm() < 1e-9 * p.norm(), "{p} vs {px}");
-    assert!((p + pz).norm() < 1e-9 * p.norm(), "{p} vs {pz}");
+    // Symmetric to the solver's error ≈ cond·tol: the block-Jacobi leaves are not mirror-symmetric.
+    let tol = 10.0 * modal_radiation::gmres::TOLERANCE;
+    assert!((p - px).norm() < tol * p.norm(), "{p} vs {px}");
+    assert!((p + pz).norm() < tol * p.norm(), "{p} vs {pz}");
 }
 
 #[test]
