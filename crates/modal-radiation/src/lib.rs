@@ -31,6 +31,7 @@
 
 #![warn(missing_docs)]
 
+mod aca;
 pub mod assembly;
 pub mod bem;
 pub mod cluster;
