@@ -417,17 +417,8 @@ mod tests {
     /// the same bits on one thread and on three.
     #[test]
     fn compressed_gmres_matches_lu_and_is_bit_identical_across_thread_counts() {
-        use crate::cluster::Adjacency;
-        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 3);
-        let near = NearField::new(&mesh);
-        let k = 2.0 * std::f64::consts::PI * 6000.0 / 343.0;
-        let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), 0.6 / k);
-        let fields: Vec<Vec<c64>> = [0.0, 1.0]
-            .iter()
-            .map(|s| mesh.panels.iter().map(|p| c64::new(p.normal[2], s * 30.0 * p.centroid[0])).collect())
-            .collect();
-        let kern = Kernels::new(k);
-        let asm = Assembly::new(&mesh, &near, &clusters, &kern, c64::new(0.0, 1.0 / k), &fields, true);
+        let system = crate::hmatrix::system_tests::EllipsoidSystem::new();
+        let asm = system.assembly();
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| compressed_solve(&asm).expect("GMRES converges"))

@@ -411,12 +411,45 @@ mod tests {
 }
 
 #[cfg(test)]
-mod system_tests {
+pub(crate) mod system_tests {
     use super::*;
     use crate::aca::system_tests::two_fields;
     use crate::cluster::{Adjacency, Clusters};
     use crate::kernels::Kernels;
     use crate::near::NearField;
+
+    /// The compressed path's test system: an ellipsoid of 1 280 panels at
+    /// 6 kHz, clustered at `κ = 0.6` (about 1 100 unknowns, enough for
+    /// admissible blocks), with [`two_fields`].
+    pub(crate) struct EllipsoidSystem {
+        mesh: crate::geometry::BoundaryMesh,
+        near: NearField,
+        clusters: Clusters,
+        fields: Vec<Vec<c64>>,
+        kern: Kernels,
+        k: f64,
+    }
+
+    impl EllipsoidSystem {
+        pub(crate) fn new() -> EllipsoidSystem {
+            let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 3);
+            let k = 2.0 * std::f64::consts::PI * 6000.0 / 343.0;
+            EllipsoidSystem {
+                near: NearField::new(&mesh),
+                clusters: Clusters::grow(&mesh, &Adjacency::new(&mesh), 0.6 / k),
+                fields: two_fields(&mesh),
+                kern: Kernels::new(k),
+                mesh,
+                k,
+            }
+        }
+
+        /// Its Burton–Miller assembly (`α = i/k`).
+        pub(crate) fn assembly(&self) -> Assembly<'_> {
+            let alpha = c64::new(0.0, 1.0 / self.k);
+            Assembly::new(&self.mesh, &self.near, &self.clusters, &self.kern, alpha, &self.fields, true)
+        }
+    }
 
     /// The compressed matrix against the dense assembly of the same system
     /// (an ellipsoid, 1 280 panels, 6 kHz, two fields): product
@@ -426,13 +459,8 @@ mod system_tests {
     /// within 1e-8, right-hand sides within 1e-7.
     #[test]
     fn compressed_system_matches_the_dense_one() {
-        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.06, 0.04], 3);
-        let near = NearField::new(&mesh);
-        let k = 2.0 * std::f64::consts::PI * 6000.0 / 343.0;
-        let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), 0.6 / k);
-        let fields = two_fields(&mesh);
-        let kern = Kernels::new(k);
-        let asm = Assembly::new(&mesh, &near, &clusters, &kern, c64::new(0.0, 1.0 / k), &fields, true);
+        let system = EllipsoidSystem::new();
+        let asm = system.assembly();
         let n = asm.len();
         let (at, rhs) = crate::assembly::assemble_dense(&asm);
         let (h, hrhs) = HMatrix::assemble(&asm);
