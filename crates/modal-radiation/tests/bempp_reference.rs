@@ -214,6 +214,14 @@ fn assert_criterion(errs: &[(usize, Vec<(f64, f64)>)]) {
     assert!(median <= 1.0 && max <= 3.0, "median {median:.3} dB, max {max:.3} dB over {n} mode-points");
 }
 
+/// [`cross_check`] of `modes` (all when `None`), exactly `counted` of them
+/// within 40 dB of the loudest mode, and [`assert_criterion`] on them.
+fn assert_modes_agree(bank_file: &str, reference_file: &str, modes: Option<&[usize]>, counted: usize) {
+    let (errs, left_out, _) = cross_check(bank_file, reference_file, modes);
+    assert!(errs.len() == counted, "{counted} modes counted, {} were: {left_out:?} left out", errs.len());
+    assert_criterion(&errs);
+}
+
 #[test]
 fn demo_bar_modes_agree_with_the_bempp_reference() {
     let (errs, left_out, _) = cross_check("bar8.bank", "bar8_bempp.json", None);
@@ -224,9 +232,7 @@ fn demo_bar_modes_agree_with_the_bempp_reference() {
 /// The bowl's lowest pair (1143 Hz), in the default suite (a few seconds).
 #[test]
 fn demo_bowl_lowest_pair_agrees_with_the_bempp_reference() {
-    let (errs, _, _) = cross_check("bowl60.bank", "bowl60_bempp.json", Some(&[0]));
-    assert_eq!(errs.len(), 1);
-    assert_criterion(&errs);
+    assert_modes_agree("bowl60.bank", "bowl60_bempp.json", Some(&[0]), 1);
 }
 
 /// The bowl's four lowest pairs, 1.1–8.1 kHz (about 1.5 min in the
@@ -244,9 +250,7 @@ fn demo_bowl_lowest_pair_agrees_with_the_bempp_reference() {
 #[test]
 #[ignore = "about 3 min: the bowl's four lowest pairs"]
 fn demo_bowl_modes_agree_with_the_bempp_reference() {
-    let (errs, left_out, _) = cross_check("bowl60.bank", "bowl60_bempp.json", None);
-    assert!(errs.len() == 4, "all four pairs counted: {left_out:?} left out");
-    assert_criterion(&errs);
+    assert_modes_agree("bowl60.bank", "bowl60_bempp.json", None, 4);
 }
 
 /// The small bowl against a reference converged across its 4 mm wall.
@@ -257,18 +261,14 @@ fn demo_bowl_modes_agree_with_the_bempp_reference() {
 /// the panels' own error (k·h = 0.81), the rest was the clusters'.
 #[test]
 fn small_bowl_agrees_with_a_converged_bempp_reference() {
-    let (errs, left_out, _) = cross_check("bowl30.bank", "bowl30_bempp.json", None);
-    assert!(errs.len() == 2, "both pairs counted: {left_out:?} left out");
-    assert_criterion(&errs);
+    assert_modes_agree("bowl30.bank", "bowl30_bempp.json", None, 2);
 }
 
 /// A two-part object (two parallel bars 10 mm apart), its two lowest modes
 /// in the default suite.
 #[test]
 fn two_bars_lowest_modes_agree_with_the_bempp_reference() {
-    let (errs, _, _) = cross_check("twobars.bank", "twobars_bempp.json", Some(&[0, 1]));
-    assert_eq!(errs.len(), 2);
-    assert_criterion(&errs);
+    assert_modes_agree("twobars.bank", "twobars_bempp.json", Some(&[0, 1]), 2);
 }
 
 /// Every mode of the two-part object, 2.7–13.5 kHz (about 1.5 min in the
@@ -283,9 +283,7 @@ fn two_bars_lowest_modes_agree_with_the_bempp_reference() {
 #[test]
 #[ignore = "about 1.5 min: ten modes of a two-part object"]
 fn two_bars_every_mode_agrees_with_the_bempp_reference() {
-    let (errs, left_out, _) = cross_check("twobars.bank", "twobars_bempp.json", None);
-    assert!(errs.len() == 10, "all ten modes counted: {left_out:?} left out");
-    assert_criterion(&errs);
+    assert_modes_agree("twobars.bank", "twobars_bempp.json", None, 10);
 }
 
 /// Re-runs the references (needs the Python packages of `tools/rad_ref.py`;
