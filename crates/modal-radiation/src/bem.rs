@@ -136,11 +136,11 @@ impl SurfaceField {
     }
 
     /// Pressure at `x` in the air [Pa] (representation formula). Errors
-    /// when `x` lies inside the body.
+    /// when `x` lies inside the body or on its surface
+    /// ([`BoundaryMesh::check_field_point`]: closer to a panel than the
+    /// formula's quadrature is accurate).
     pub fn pressure_at(&self, mesh: &BoundaryMesh, x: [f64; 3]) -> Result<c64, RadiationError> {
-        if mesh.contains(x) {
-            return Err(RadiationError::PointInsideBody { x: x[0], y: x[1], z: x[2] });
-        }
+        mesh.check_field_point(x)?;
         let kern = Kernels::new(self.wavenumber);
         let mut p = c64::new(0.0, 0.0);
         for (j, panel) in mesh.panels.iter().enumerate() {
