@@ -73,12 +73,7 @@ fn parse_point(text: &str) -> Result<[f64; 3], String> {
 /// surface, its corner triangles (the low-frequency level of
 /// `radiate_modes`, whose larger panels keep points farther away).
 pub fn check_field_points(bank: &ModeBank, mesh: &BoundaryMesh, points: &[[f64; 3]]) -> Result<()> {
-    let corners = match bank.surface.triangle_edge_nodes {
-        Some(_) if !points.is_empty() => {
-            Some(BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?)
-        }
-        _ => None,
-    };
+    let corners = if points.is_empty() { None } else { modal_radiation::modes::corner_mesh(bank)? };
     for &x in points {
         let place = mesh.classify(x);
         corners.as_ref().map_or(place, |c| place.and(c.classify(x))).check(x)?;
