@@ -21,8 +21,9 @@ use super::progress::Spinner;
 
 /// Default `--transfer-max-freq` [Hz]: modes up to it get their acoustic
 /// transfer solved (once per asset, cached), higher ones keep the level
-/// estimate. Measured (docs/radiation-render/README.md): the demo's three
-/// assets cost about a minute at this cap, every mode tens of minutes.
+/// estimate. Measured (BENCHMARKS.md, "Cost today", 2026-11-26): the
+/// demo's three assets cost about 15 s at this cap on 2 cores (against
+/// 2.5–3 s of eigen solves), every playable mode about 4 minutes.
 pub const DEFAULT_TRANSFER_MAX_HZ: f64 = 6000.0;
 
 /// Where the demo is written when no output is given.
