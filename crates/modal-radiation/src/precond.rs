@@ -23,7 +23,7 @@
 //! fixed order.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::lu::partial_pivoting::{factor, inverse};
+use faer::linalg::lu::partial_pivoting::inverse;
 use faer::{c64, Mat, MatMut, Par};
 
 /// One inverted diagonal block.
@@ -107,29 +107,11 @@ fn invert(a: &[c64], m: usize) -> Option<Vec<c64>> {
     // `aᵀ` keeps both in row-major order without copies.
     let mut lu = a.to_vec();
     let mut lu = MatMut::from_column_major_slice_mut(&mut lu, m, m);
-    let (mut perm, mut perm_inv) = (vec![0usize; m], vec![0usize; m]);
+    let p = crate::bem::lu_in_place(lu.as_mut())?;
     let par = Par::Seq;
-    let mut buf = MemBuffer::new(
-        factor::lu_in_place_scratch::<usize, c64>(m, m, par, Default::default())
-            .or(inverse::inverse_scratch::<usize, c64>(m, par)),
-    );
-    let (_, p) = factor::lu_in_place(
-        lu.as_mut(),
-        &mut perm,
-        &mut perm_inv,
-        par,
-        MemStack::new(&mut buf),
-        Default::default(),
-    );
-    let regular = (0..m).all(|i| {
-        let d = lu[(i, i)];
-        d.norm() != 0.0 && d.re.is_finite() && d.im.is_finite()
-    });
-    if !regular {
-        return None;
-    }
+    let mut buf = MemBuffer::new(inverse::inverse_scratch::<usize, c64>(m, par));
     let mut inv = Mat::<c64>::zeros(m, m);
-    inverse::inverse(inv.as_mut(), lu.as_ref(), lu.as_ref(), p, par, MemStack::new(&mut buf));
+    inverse::inverse(inv.as_mut(), lu.as_ref(), lu.as_ref(), p.as_ref(), par, MemStack::new(&mut buf));
     // `inv` is (aᵀ)⁻¹ = (a⁻¹)ᵀ: entry (i, j) of a⁻¹ is inv(j, i).
     let out: Vec<c64> = (0..m * m).map(|k| inv[(k % m, k / m)]).collect();
     out.iter().all(|z| z.re.is_finite() && z.im.is_finite()).then_some(out)
