@@ -199,6 +199,53 @@ fn points_inside_the_body_and_bad_air_are_clear_errors() {
         .fails_with("does not exist");
 }
 
+/// Issue #15: a face centre and a corner of a block (its winding number is ½
+/// and ⅛ there) are on the surface, for `--point` and `--listener` alike:
+/// refused before any solve, nothing on stdout; moving the point as far as
+/// the error line says makes it valid.
+#[test]
+fn issue_15_points_on_the_block_surface_are_refused_and_the_advice_works() {
+    let dir = temp_dir();
+    modal(
+        dir.path(),
+        &["mesh", "box", "--size", "0.08,0.05,0.04", "--h", "0.02", "--order", "2", "-o", "b.msh"],
+    )
+    .ok();
+    modal(
+        dir.path(),
+        &["precompute", "b.msh", "-o", "b.bank", "--modes", "4", "--material", "wood", "--no-cache"],
+    )
+    .ok();
+    // Face centre (outward −z) and corner (outward −x−y−z).
+    let s3 = 1.0 / 3f64.sqrt();
+    for (at, out) in [([0.04, 0.025, 0.0], [0.0, 0.0, -1.0]), ([0.0; 3], [-s3, -s3, -s3])] {
+        let p = format!("{},{},{}", at[0], at[1], at[2]);
+        let refused = modal(dir.path(), &["radiation", "b.bank", "--point", &p, "--json"])
+            .fails_with("lies on the body's surface");
+        assert!(refused.stdout.is_empty() && !refused.stderr.contains("inside"), "{}", refused.stderr);
+        assert!(!refused.stderr.contains("radiation 1/"), "refused after a solve: {}", refused.stderr);
+        let heard = modal(
+            dir.path(),
+            &["strike", "b.bank", "--at", "0.04,0.025,0.04", "--listener", &p, "-o", "x.wav"],
+        )
+        .fails_with("lies on the body's surface");
+        assert!(heard.stdout.is_empty() && !dir.path().join("x.wav").exists());
+        // "move the point at least T m away from the surface": 1.1 T is enough.
+        let t: f64 =
+            refused.stderr.split("at least ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+        let x = [0, 1, 2].map(|k| at[k] + 1.1 * t * out[k]);
+        let p = format!("{},{},{}", x[0], x[1], x[2]);
+        let json =
+            modal(dir.path(), &["radiation", "b.bank", "--point", &p, "--mode", "0", "--json"]).ok().json();
+        let z = &json["modes"][0]["pressure_pa"][0];
+        assert!(z[0].as_f64().unwrap().hypot(z[1].as_f64().unwrap()) > 0.0, "{json}");
+        // Just inside that distance it is still on the surface.
+        let x = [0, 1, 2].map(|k| at[k] + 0.9 * t * out[k]);
+        let p = format!("{},{},{}", x[0], x[1], x[2]);
+        modal(dir.path(), &["radiation", "b.bank", "--point", &p]).fails_with("lies on the body's surface");
+    }
+}
+
 #[test]
 fn pressure_scales_with_air_density_and_skips_inaudible_modes() {
     let dir = temp_dir();

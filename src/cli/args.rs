@@ -403,9 +403,10 @@ pub struct RenderArgs {
     /// Highest mode frequency [Hz] whose acoustic transfer is solved when a
     /// mesh asset has none cached; modes above it keep the level estimate
     /// (said on stderr). The default, 6 kHz, solves the modes the estimate
-    /// gets most wrong (low `ka`) at a cost of seconds to a minute per
-    /// asset; `--transfer-max-freq 24000` solves every playable mode
-    /// (minutes to tens of minutes for a thin bowl; docs/radiation-render).
+    /// gets most wrong (low `ka`) at a cost of seconds per asset (the demo:
+    /// ≈ 15 s for all three); `--transfer-max-freq 24000` solves every
+    /// playable mode (the demo's thin bowl: ≈ 3–4 minutes on 2 cores;
+    /// BENCHMARKS.md, "Cost today").
     #[arg(long, value_name = "HZ")]
     pub transfer_max_freq: Option<f64>,
     /// Accepted for old scripts: solving the transfer is now the default.

@@ -17,7 +17,7 @@
 
 use std::path::Path;
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{Context, Result};
 use modal_bank::ModeBank;
 use modal_radiation::{Air, RadiationOptions};
 use modal_scene::{AIR_IMPEDANCE_PA_S_M, FULL_SCALE_PA, MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
@@ -51,13 +51,7 @@ pub struct ListenerGains {
 /// Gains for a listener at `x` (bank frame) of the bank stored at `path`.
 pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) -> Result<ListenerGains> {
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
-    ensure!(
-        !mesh.contains(x),
-        "listener {},{},{} lies inside the body: pressure is only defined outside it",
-        x[0],
-        x[1],
-        x[2]
-    );
+    super::radiation::check_field_points(bank, &mesh, &[x]).context("--listener")?;
     let audible: Vec<usize> = (0..bank.mode_count())
         .filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ)
         .collect();

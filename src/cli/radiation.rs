@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use anyhow::{ensure, Context, Result};
 use clap::Args;
-use modal_radiation::{Air, RadiationOptions};
+use modal_bank::ModeBank;
+use modal_radiation::{Air, BoundaryMesh, RadiationOptions};
 use serde::Serialize;
 
 use super::bank_cmds::load_bank;
@@ -65,6 +66,21 @@ fn parse_point(text: &str) -> Result<[f64; 3], String> {
     Ok(p)
 }
 
+/// Refuses field points on the bank's surface or inside the body before
+/// any solve, by the library's classification
+/// ([`BoundaryMesh::check_field_point`]) on every panel level a solve may
+/// evaluate the pressure on: the panels `mesh` and, for a quadratic
+/// surface, its corner triangles (the low-frequency level of
+/// `radiate_modes`, whose larger panels keep points farther away).
+pub fn check_field_points(bank: &ModeBank, mesh: &BoundaryMesh, points: &[[f64; 3]]) -> Result<()> {
+    let corners = if points.is_empty() { None } else { modal_radiation::modes::corner_mesh(bank)? };
+    for &x in points {
+        let place = mesh.classify(x);
+        corners.as_ref().map_or(place, |c| place.and(c.classify(x))).check(x)?;
+    }
+    Ok(())
+}
+
 #[derive(Serialize)]
 struct RadiationJson {
     air_density_kg_m3: f64,
@@ -95,15 +111,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     ensure!(args.max_freq > 0.0, "--max-freq must be positive");
     ensure!(args.cluster_kh.is_finite() && args.cluster_kh > 0.0, "--cluster-kh must be finite and positive");
     let mesh = modal_radiation::modes::boundary_mesh(&bank).context("the bank's surface cannot be used")?;
-    for p in &args.point {
-        ensure!(
-            !mesh.contains(*p),
-            "point {},{},{} lies inside the body: pressure is only defined outside it",
-            p[0],
-            p[1],
-            p[2]
-        );
-    }
+    check_field_points(&bank, &mesh, &args.point).context("--point")?;
     let audible = |i: usize| {
         let f = bank.damped_frequency_hz(i);
         f >= AUDIBLE_MIN_HZ && bank.frequencies_hz[i] <= args.max_freq

@@ -21,8 +21,9 @@ use super::progress::Spinner;
 
 /// Default `--transfer-max-freq` [Hz]: modes up to it get their acoustic
 /// transfer solved (once per asset, cached), higher ones keep the level
-/// estimate. Measured (docs/radiation-render/README.md): the demo's three
-/// assets cost about a minute at this cap, every mode tens of minutes.
+/// estimate. Measured (BENCHMARKS.md, "Cost today", 2026-11-26): the
+/// demo's three assets cost about 15 s at this cap on 2 cores (against
+/// 2.5–3 s of eigen solves), every playable mode about 4 minutes.
 pub const DEFAULT_TRANSFER_MAX_HZ: f64 = 6000.0;
 
 /// Where the demo is written when no output is given.
@@ -179,7 +180,7 @@ impl PipelineProvider<'_> {
                 // as points (modal_radiation::assembly); v5: 3-point rule for far panels at
                 // 1 < k·h ≤ 2; v6: default pressure clusters κ = 0.3 (was 0.5); v7: compressed
                 // (H-matrix, ACA) assembly from 4 000 unknowns.
-                let key = CacheKey::new("modal-radiation-v8")
+                let key = CacheKey::new("modal-radiation-v9")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)

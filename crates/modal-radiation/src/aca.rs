@@ -244,8 +244,9 @@ fn aca(mat: &mut dyn Crosses, max_rank: usize) -> Option<(Vec<Vec<c64>>, Vec<Vec
                 *x -= a * v;
             }
         }
+        // Pivots by |x|² (no `hypot`): the same order as by |x|.
         let (j, pivot) = r.iter().enumerate().fold((0, 0.0f64), |best, (j, x)| {
-            let a = x.norm();
+            let a = x.norm_sqr();
             if a > best.1 {
                 (j, a)
             } else {
@@ -278,8 +279,9 @@ fn aca(mat: &mut dyn Crosses, max_rank: usize) -> Option<(Vec<Vec<c64>>, Vec<Vec
         let (uu, vv) = (sq(&u), sq(&v));
         let cross: f64 = us.iter().zip(&vs).map(|(uk, vk)| (cdot(uk, &u) * cdot(vk, &v)).re).sum();
         norm2 += uu * vv + 2.0 * cross;
-        let next =
-            (0..m).filter(|&p| !used[p]).max_by(|&a, &b| u[a].norm().total_cmp(&u[b].norm()).then(b.cmp(&a)));
+        let next = (0..m)
+            .filter(|&p| !used[p])
+            .max_by(|&a, &b| u[a].norm_sqr().total_cmp(&u[b].norm_sqr()).then(b.cmp(&a)));
         us.push(u);
         vs.push(v);
         if (uu * vv).sqrt() <= ACA_TOLERANCE * norm2.max(0.0).sqrt() {

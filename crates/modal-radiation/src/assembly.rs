@@ -34,9 +34,10 @@ use faer::c64;
 use rayon::prelude::*;
 
 use crate::cluster::Clusters;
-use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
-use crate::kernels::{Kernels, PanelIntegrals, PointKernel};
+use crate::geometry::{norm, sub, BoundaryMesh, Panel};
+use crate::kernels::{CoupledKernels, Kernels, PointKernel};
 use crate::near::NearField;
+use crate::quadrature::TRIANGLE_3;
 
 /// Panels closer than this many (cluster radius + panel diameter) to a
 /// cluster's centre are tested at every member centroid; farther ones at
@@ -76,10 +77,40 @@ pub const THREE_POINT_MAX_KH: f64 = 2.0;
 /// (and `k·ρ_c ≤ 1`, and no member is near the row's cluster).
 pub const AGGREGATE_RATIO: f64 = 8.0;
 
+/// A source panel as the far rules read it, stored in cluster order so
+/// that a row's sweep over a cluster reads consecutive memory: centroid, normal,
+/// area, diameter, the points of the 3-point rule and its index in the mesh.
+struct SourcePanel {
+    centroid: [f64; 3],
+    normal: [f64; 3],
+    area: f64,
+    diameter: f64,
+    points: [[f64; 3]; 3],
+    index: usize,
+}
+
+impl SourcePanel {
+    fn new(mesh: &BoundaryMesh, index: usize) -> SourcePanel {
+        let p = &mesh.panels[index];
+        let t = p.corners.map(|i| mesh.vertices[i]);
+        let points =
+            TRIANGLE_3.map(|(b, _)| [0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k]));
+        SourcePanel {
+            centroid: p.centroid,
+            normal: p.normal,
+            area: p.area,
+            diameter: p.diameter,
+            points,
+            index,
+        }
+    }
+}
+
 /// A cluster as test region and as source: its panels with area weights,
 /// its area-weighted centre and normal, its radius about the centre
 /// (member centroid distance plus diameter), its area, the area-weighted
-/// sum of its normals and its largest panel diameter.
+/// sum of its normals, its largest panel diameter, and its panels' range
+/// in [`Assembly::sources`].
 struct Region {
     members: Vec<(usize, f64)>,
     centre: [f64; 3],
@@ -87,14 +118,16 @@ struct Region {
     radius: f64,
     normal_sum: [f64; 3],
     max_diameter: f64,
+    span: std::ops::Range<usize>,
 }
 
-fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<Region> {
+/// The regions of `clusters` and the source panels in cluster order.
+fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> (Vec<Region>, Vec<SourcePanel>) {
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); clusters.len()];
     for (p, &c) in clusters.of_panel.iter().enumerate() {
         members[c].push(p);
     }
-    members
+    let regions = members
         .into_iter()
         .map(|m| {
             let area: f64 = m.iter().map(|&p| mesh.panels[p].area).sum();
@@ -110,9 +143,18 @@ fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> Vec<Region> {
                 .fold(0.0, f64::max);
             let max_diameter = m.iter().map(|&p| mesh.panels[p].diameter).fold(0.0, f64::max);
             let members = m.iter().map(|&p| (p, mesh.panels[p].area / area)).collect();
-            Region { members, centre, normal: normal_sum.map(|x| x / len), radius, normal_sum, max_diameter }
+            let normal = normal_sum.map(|x| x / len);
+            Region { members, centre, normal, radius, normal_sum, max_diameter, span: 0..0 }
         })
-        .collect()
+        .collect::<Vec<_>>();
+    let mut sources = Vec::with_capacity(mesh.len());
+    let mut regions = regions;
+    for region in &mut regions {
+        let first = sources.len();
+        sources.extend(region.members.iter().map(|&(j, _)| SourcePanel::new(mesh, j)));
+        region.span = first..sources.len();
+    }
+    (regions, sources)
 }
 
 /// `Σ A_j q_j` and `Σ A_j q_j (c_j − y_c)` (real and imaginary parts) of one
@@ -122,30 +164,6 @@ struct Moments {
     q: c64,
     d_re: [f64; 3],
     d_im: [f64; 3],
-}
-
-/// The four panel integrals of `panel` seen from `x`: one centroid point
-/// when far ([`FAR_POINT_RATIO`]) and `k·h ≤ 1`, three points at mid
-/// range ([`MID_POINT_RATIO`]) or when far with `k·h ≤`
-/// [`THREE_POINT_MAX_KH`], the adaptive rule otherwise.
-fn integrals(
-    kern: &Kernels,
-    mesh: &BoundaryMesh,
-    panel: &Panel,
-    x: [f64; 3],
-    nx: [f64; 3],
-) -> PanelIntegrals {
-    let d = sub(panel.centroid, x);
-    let r2 = dot(d, d);
-    let kh = kern.k() * panel.diameter;
-    let (far, mid) = (FAR_POINT_RATIO * panel.diameter, MID_POINT_RATIO * panel.diameter);
-    if kh <= 1.0 && r2 > far * far {
-        kern.point(x, nx, panel.centroid, panel.normal, panel.area)
-    } else if kh <= THREE_POINT_MAX_KH && r2 > mid * mid {
-        kern.three_point(mesh, panel, x, nx)
-    } else {
-        kern.panel(mesh, panel, x, nx)
-    }
 }
 
 /// The operators of one solve: the geometry, the kernels at one wavenumber,
@@ -160,7 +178,9 @@ pub(crate) struct Assembly<'a> {
     alpha: c64,
     q: &'a [Vec<c64>],
     aggregate: bool,
+    coupled: CoupledKernels,
     regions: Vec<Region>,
+    sources: Vec<SourcePanel>,
     moments: Vec<Vec<Moments>>,
 }
 
@@ -179,7 +199,7 @@ impl<'a> Assembly<'a> {
         aggregate: bool,
     ) -> Assembly<'a> {
         let zero = c64::new(0.0, 0.0);
-        let regions = regions(mesh, clusters);
+        let (regions, sources) = regions(mesh, clusters);
         let moments = regions
             .iter()
             .map(|src| {
@@ -201,7 +221,8 @@ impl<'a> Assembly<'a> {
                     .collect()
             })
             .collect();
-        Assembly { mesh, near_field, kern, alpha, q, aggregate, regions, moments }
+        let coupled = CoupledKernels::new(kern.k(), alpha);
+        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments }
     }
 
     /// Number of unknowns (clusters).
@@ -258,31 +279,31 @@ impl<'a> Assembly<'a> {
                 }
                 continue;
             }
-            for &(j, _) in &src.members {
-                let (a, op) = self.pair(i, j);
+            for panel in &self.sources[src.span.clone()] {
+                let (a, op) = self.pair(i, panel);
                 *slot += a;
                 for (bf, qf) in b.iter_mut().zip(self.q) {
-                    *bf += op * qf[j];
+                    *bf += op * qf[panel.index];
                 }
             }
         }
     }
 
-    /// Panel `j`'s weights in row `i`, integrated on its own: its term of
+    /// Panel `src`'s weights in row `i`, integrated on its own: its term of
     /// `A_ic` (`c` its cluster) and its factor `op` in `b_i += op·q_j`.
-    fn pair(&self, i: usize, j: usize) -> (c64, c64) {
+    fn pair(&self, i: usize, src: &SourcePanel) -> (c64, c64) {
         let (kern, mesh, alpha) = (self.kern, self.mesh, self.alpha);
         let zero = c64::new(0.0, 0.0);
         let region = &self.regions[i];
-        let pj = &mesh.panels[j];
-        let dist = norm(sub(pj.centroid, region.centre));
+        let dist = norm(sub(src.centroid, region.centre));
         let near = region.members.len() == 1
-            || dist < CLUSTER_NEAR_RATIO * (region.radius + pj.diameter)
-            || dist < region.radius + MID_POINT_RATIO * pj.diameter;
+            || dist < CLUSTER_NEAR_RATIO * (region.radius + src.diameter)
+            || dist < region.radius + MID_POINT_RATIO * src.diameter;
         if !near {
-            let ints = integrals(kern, mesh, pj, region.centre, region.normal);
-            return (-ints.dg_dny - alpha * ints.d2g, -(ints.g + alpha * ints.dg_dnx));
+            return self.off_panel(src, region.centre, region.normal, dist);
         }
+        let j = src.index;
+        let pj = &mesh.panels[j];
         let (mut a, mut op) = (zero, zero);
         for &(t, w) in &region.members {
             let pt = &mesh.panels[t];
@@ -292,7 +313,11 @@ impl<'a> Assembly<'a> {
             } else if let Ok(s) = panels.binary_search(&(j as u32)) {
                 kern.near(mesh, pj, pt.centroid, pt.normal, &statics[s])
             } else {
-                integrals(kern, mesh, pj, pt.centroid, pt.normal)
+                let (da, dop) =
+                    self.off_panel(src, pt.centroid, pt.normal, norm(sub(src.centroid, pt.centroid)));
+                a += da * w;
+                op += dop * w;
+                continue;
             };
             let half = if t == j { 0.5 } else { 0.0 };
             a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
@@ -300,6 +325,23 @@ impl<'a> Assembly<'a> {
             op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
         }
         (a, op)
+    }
+
+    /// `(a, op)` of panel `src` seen from `x` (normal `nx`) at distance `r`
+    /// from its centroid, off its near field: one centroid point when far
+    /// ([`FAR_POINT_RATIO`]) and `k·h ≤ 1`, three points at mid range
+    /// ([`MID_POINT_RATIO`]) or when far with `k·h ≤`
+    /// [`THREE_POINT_MAX_KH`], the adaptive rule otherwise.
+    fn off_panel(&self, src: &SourcePanel, x: [f64; 3], nx: [f64; 3], r: f64) -> (c64, c64) {
+        let kh = self.kern.k() * src.diameter;
+        if kh <= 1.0 && r > FAR_POINT_RATIO * src.diameter {
+            self.coupled.point(x, nx, src.centroid, src.normal, src.area)
+        } else if kh <= THREE_POINT_MAX_KH && r > MID_POINT_RATIO * src.diameter {
+            self.coupled.three_point(x, nx, &src.points, src.normal, src.area)
+        } else {
+            let ints = self.kern.panel(self.mesh, &self.mesh.panels[src.index], x, nx);
+            (-ints.dg_dny - self.alpha * ints.d2g, -(ints.g + self.alpha * ints.dg_dnx))
+        }
     }
 }
 

@@ -35,6 +35,7 @@
 use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::perm::Perm;
 use faer::{Mat, MatMut, MatRef, Par};
 
 use crate::assembly::{assemble_dense, Assembly};
@@ -136,11 +137,11 @@ impl SurfaceField {
     }
 
     /// Pressure at `x` in the air [Pa] (representation formula). Errors
-    /// when `x` lies inside the body.
+    /// when `x` lies inside the body or on its surface
+    /// ([`BoundaryMesh::check_field_point`]: closer to a panel than the
+    /// formula's quadrature is accurate).
     pub fn pressure_at(&self, mesh: &BoundaryMesh, x: [f64; 3]) -> Result<c64, RadiationError> {
-        if mesh.contains(x) {
-            return Err(RadiationError::PointInsideBody { x: x[0], y: x[1], z: x[2] });
-        }
+        mesh.check_field_point(x)?;
         let kern = Kernels::new(self.wavenumber);
         let mut p = c64::new(0.0, 0.0);
         for (j, panel) in mesh.panels.iter().enumerate() {
@@ -318,30 +319,37 @@ fn gmres_solve(
 /// zero or the solution is not finite.
 fn lu_solve_transposed(at: &mut [c64], n: usize, rhs: &mut [c64], nrhs: usize) -> Option<Mat<c64>> {
     let mut lu = MatMut::from_column_major_slice_mut(at, n, n);
-    let mut perm = vec![0usize; n];
-    let mut perm_inv = vec![0usize; n];
+    let p = lu_in_place(lu.as_mut())?;
+    let lu_ref: MatRef<'_, c64> = lu.as_ref();
+    let par = Par::Seq;
+    let mut x = Mat::from_fn(n, nrhs, |i, f| rhs[i * nrhs + f]);
+    let mut buf = MemBuffer::new(solve::solve_transpose_in_place_scratch::<usize, c64>(n, nrhs, par));
+    solve::solve_transpose_in_place(lu_ref, lu_ref, p.as_ref(), x.as_mut(), par, MemStack::new(&mut buf));
+    let finite = (0..nrhs).all(|f| x.col(f).iter().all(|z| z.re.is_finite() && z.im.is_finite()));
+    finite.then_some(x)
+}
+
+/// `P A = L U` of the square `a` in place (faer, partial pivoting, one
+/// thread: the same bits for any thread count); the row permutation `P`,
+/// or `None` when a pivot is zero or a factor not finite.
+pub(crate) fn lu_in_place(mut a: MatMut<'_, c64>) -> Option<Perm<usize>> {
+    let n = a.nrows();
+    let (mut perm, mut perm_inv) = (vec![0usize; n], vec![0usize; n]);
     let par = Par::Seq;
     let mut buf = MemBuffer::new(factor::lu_in_place_scratch::<usize, c64>(n, n, par, Default::default()));
-    let (_, p) = factor::lu_in_place(
-        lu.as_mut(),
+    factor::lu_in_place(
+        a.as_mut(),
         &mut perm,
         &mut perm_inv,
         par,
         MemStack::new(&mut buf),
         Default::default(),
     );
-    let lu_ref: MatRef<'_, c64> = lu.as_ref();
-    if (0..n).any(|i| {
-        let d = lu_ref[(i, i)];
-        d.norm() == 0.0 || !d.re.is_finite() || !d.im.is_finite()
-    }) {
-        return None;
-    }
-    let mut x = Mat::from_fn(n, nrhs, |i, f| rhs[i * nrhs + f]);
-    let mut buf = MemBuffer::new(solve::solve_transpose_in_place_scratch::<usize, c64>(n, nrhs, par));
-    solve::solve_transpose_in_place(lu_ref, lu_ref, p, x.as_mut(), par, MemStack::new(&mut buf));
-    let finite = (0..nrhs).all(|f| x.col(f).iter().all(|z| z.re.is_finite() && z.im.is_finite()));
-    finite.then_some(x)
+    let regular = (0..n).all(|i| {
+        let d = a[(i, i)];
+        d.norm() != 0.0 && d.re.is_finite() && d.im.is_finite()
+    });
+    regular.then(|| Perm::new_checked(perm.into_boxed_slice(), perm_inv.into_boxed_slice(), n))
 }
 
 #[cfg(test)]

@@ -63,6 +63,27 @@ pub enum RadiationError {
         /// z [m].
         z: f64,
     },
+    /// A field point lies on the surface, or closer to it than the
+    /// representation formula is accurate
+    /// ([`crate::geometry::ON_SURFACE_RATIO`]).
+    #[error(
+        "point ({x}, {y}, {z}) lies on the body's surface ({} m from it): pressure is evaluated only \
+         in the air; move the point at least {} m away from the surface",
+        metres(*.distance_m),
+        metres(*.tolerance_m)
+    )]
+    PointOnSurface {
+        /// x [m].
+        x: f64,
+        /// y [m].
+        y: f64,
+        /// z [m].
+        z: f64,
+        /// Distance to the nearest panel [m].
+        distance_m: f64,
+        /// Distance the point must keep from the surface [m].
+        tolerance_m: f64,
+    },
     /// The dense solve failed (singular system).
     #[error("the boundary-element system at {frequency_hz} Hz is singular")]
     Singular {
@@ -88,4 +109,13 @@ pub enum RadiationError {
     /// The bank's surface or shapes are unusable.
     #[error("bank surface: {0}")]
     Bank(String),
+}
+
+/// A length for an error line: `0` exactly, else three significant digits.
+fn metres(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.2e}")
+    }
 }

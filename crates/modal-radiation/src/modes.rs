@@ -156,6 +156,14 @@ pub fn boundary_mesh(bank: &ModeBank) -> Result<BoundaryMesh, RadiationError> {
     }
 }
 
+/// The corner triangles of a quadratic bank surface (the coarse panel
+/// level of low-frequency solves, on the same vertices as
+/// [`boundary_mesh`]); `None` for a linear surface, which has one level.
+pub fn corner_mesh(bank: &ModeBank) -> Result<Option<BoundaryMesh>, RadiationError> {
+    let s = &bank.surface;
+    s.triangle_edge_nodes.as_ref().map(|_| BoundaryMesh::new(s.positions.clone(), &s.triangles)).transpose()
+}
+
 /// Panels whose normal is within this angle of a node's smooth-surface
 /// normal use that normal at that corner; across creases (a bar's edges)
 /// the panel's own normal is used. Also the angle at which
@@ -403,20 +411,17 @@ impl Panels {
         let normals = corner_normals_of(bank, mesh, &smooth);
         let taps =
             mesh.panels.iter().zip(&normals).map(|(p, n)| [0, 1, 2].map(|k| (p.corners[k], n[k]))).collect();
-        let coarse = match (&bank.surface.triangle_edge_nodes, adaptive) {
-            (Some(edges), true) => {
-                let m = BoundaryMesh::new(mesh.vertices.clone(), &bank.surface.triangles)?;
-                let taps = m
-                    .panels
-                    .iter()
-                    .zip(edges)
-                    .zip(&smooth.per_triangle)
-                    .map(|((p, e), n)| [0, 1, 2].map(|k| (e[k], smooth_or_panel(n[3 + k], p.normal))))
-                    .collect();
-                Some(Level::new(m, taps))
-            }
-            _ => None,
-        };
+        let corners = if adaptive { corner_mesh(bank)? } else { None };
+        let coarse = corners.zip(bank.surface.triangle_edge_nodes.as_ref()).map(|(m, edges)| {
+            let taps = m
+                .panels
+                .iter()
+                .zip(edges)
+                .zip(&smooth.per_triangle)
+                .map(|((p, e), n)| [0, 1, 2].map(|k| (e[k], smooth_or_panel(n[3 + k], p.normal))))
+                .collect();
+            Level::new(m, taps)
+        });
         Ok(Panels { fine: Level::new(mesh.clone(), taps), coarse })
     }
 }
