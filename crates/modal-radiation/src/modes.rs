@@ -356,13 +356,18 @@ struct Level {
     near: std::sync::OnceLock<NearField>,
     /// Longest panel edge [m].
     h: f64,
-    /// Per panel, the surface nodes whose mean of `φ·n` is its velocity, with
-    /// the normal to use at each.
-    taps: Vec<[(usize, [f64; 3]); 3]>,
+    /// Per panel, its three corners' taps: the velocity is the mean over the
+    /// corners of `φ·n`, each corner the mean of its two (node, normal)
+    /// taps (the same node twice at a surface node, an edge's two ends at
+    /// a midpoint of the [`Panels::finer`] level).
+    taps: Vec<[Corner; 3]>,
 }
 
+/// A panel corner's two (surface node, normal) taps (see [`Level::taps`]).
+type Corner = [(usize, [f64; 3]); 2];
+
 impl Level {
-    fn new(mesh: BoundaryMesh, taps: Vec<[(usize, [f64; 3]); 3]>) -> Level {
+    fn new(mesh: BoundaryMesh, taps: Vec<[Corner; 3]>) -> Level {
         Level {
             h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
             adjacency: Adjacency::new(&mesh),
@@ -380,13 +385,12 @@ impl Level {
             .taps
             .iter()
             .map(|taps| {
-                let v: f64 = taps
-                    .iter()
-                    .map(|&(c, n)| {
-                        let s = bank.shape_at(mode, c);
-                        dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
-                    })
-                    .sum();
+                let tap = |(c, n): (usize, [f64; 3])| {
+                    let s = bank.shape_at(mode, c);
+                    dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
+                };
+                // (x + x)·½ = x exactly: a node's corner gives its own value.
+                let v: f64 = taps.iter().map(|&[a, b]| (tap(a) + tap(b)) * 0.5).sum();
                 c64::new(v / 3.0, 0.0)
             })
             .collect())
@@ -400,6 +404,12 @@ impl Level {
 struct Panels {
     fine: Level,
     coarse: Option<Level>,
+    /// Each fine panel split in four at its edge midpoints (velocity
+    /// linear along each edge), when that still has at most
+    /// [`MAX_DENSE_PANELS`] panels: small objects whose fine panels are
+    /// too coarse for their top modes (`k·h > 1`) get one unknown per
+    /// panel at half the size (see [`plan`]).
+    finer: Option<Level>,
 }
 
 impl Panels {
@@ -409,8 +419,12 @@ impl Panels {
         }
         let smooth = surface_normals(bank);
         let normals = corner_normals_of(bank, mesh, &smooth);
-        let taps =
-            mesh.panels.iter().zip(&normals).map(|(p, n)| [0, 1, 2].map(|k| (p.corners[k], n[k]))).collect();
+        let taps: Vec<[Corner; 3]> = mesh
+            .panels
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| [0, 1, 2].map(|k| [(p.corners[k], n[k]); 2]))
+            .collect();
         let corners = if adaptive { corner_mesh(bank)? } else { None };
         let coarse = corners.zip(bank.surface.triangle_edge_nodes.as_ref()).map(|(m, edges)| {
             let taps = m
@@ -418,12 +432,44 @@ impl Panels {
                 .iter()
                 .zip(edges)
                 .zip(&smooth.per_triangle)
-                .map(|((p, e), n)| [0, 1, 2].map(|k| (e[k], smooth_or_panel(n[3 + k], p.normal))))
+                .map(|((p, e), n)| [0, 1, 2].map(|k| [(e[k], smooth_or_panel(n[3 + k], p.normal)); 2]))
                 .collect();
             Level::new(m, taps)
         });
-        Ok(Panels { fine: Level::new(mesh.clone(), taps), coarse })
+        let finer = if adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS {
+            Some(split_level(mesh, &taps)?)
+        } else {
+            None
+        };
+        Ok(Panels { fine: Level::new(mesh.clone(), taps), coarse, finer })
     }
+}
+
+/// The [`Panels::finer`] level of `mesh` with taps `taps`: each panel
+/// `[a, b, c]` split at its edge midpoints (shared between neighbours, so
+/// the surface stays closed) into `[a, ab, ca]`, `[ab, b, bc]`,
+/// `[ca, bc, c]`, `[ab, bc, ca]`; a midpoint's taps are its edge's ends.
+fn split_level(mesh: &BoundaryMesh, taps: &[[Corner; 3]]) -> Result<Level, RadiationError> {
+    let mut vertices = mesh.vertices.clone();
+    let mut midpoints: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
+    let mut midpoint = |a: usize, b: usize, vertices: &mut Vec<[f64; 3]>| {
+        *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+            let (va, vb) = (vertices[a], vertices[b]);
+            vertices.push([0, 1, 2].map(|k| 0.5 * (va[k] + vb[k])));
+            vertices.len() - 1
+        })
+    };
+    let (mut triangles, mut split_taps) =
+        (Vec::with_capacity(4 * mesh.len()), Vec::with_capacity(4 * mesh.len()));
+    for (panel, t) in mesh.panels.iter().zip(taps) {
+        let [a, b, c] = panel.corners;
+        let [ab, bc, ca] = [(a, b), (b, c), (c, a)].map(|(u, v)| midpoint(u, v, &mut vertices));
+        let [ta, tb, tc] = t.map(|corner| corner[0]);
+        let (tab, tbc, tca) = ([ta, tb], [tb, tc], [tc, ta]);
+        triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        split_taps.extend([[[ta; 2], tab, tca], [tab, [tb; 2], tbc], [tca, tbc, [tc; 2]], [tab, tbc, tca]]);
+    }
+    Ok(Level::new(BoundaryMesh::new(vertices, &triangles)?, split_taps))
 }
 
 /// How one frequency group was solved.
@@ -443,8 +489,9 @@ fn plan<'a>(
     opts: &RadiationOptions,
 ) -> Result<Plan<'a>, RadiationError> {
     let k_eff = k.max(ks);
-    let level = match &panels.coarse {
-        Some(c) if k * c.h <= COARSE_MAX_KH => c,
+    let level = match (&panels.coarse, &panels.finer) {
+        (Some(c), _) if k * c.h <= COARSE_MAX_KH => c,
+        (_, Some(f)) if k * panels.fine.h > UNDER_RESOLVED_KH => f,
         _ => &panels.fine,
     };
     if !opts.adaptive_resolution {
@@ -572,5 +619,47 @@ pub fn stored_multipole(table: &modal_bank::RadiationTable, entry: &modal_bank::
         fit_radius: table.fit_radius_m,
         order: entry.order,
         coefficients: entry.coefficients.iter().map(|c| c64::new(c[0], c[1])).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The finer level of a closed surface is closed (inside point still
+    /// inside), has four times the panels, `V + E` vertices and the same
+    /// area, and its taps keep every panel's integral of a velocity that is
+    /// linear over each parent panel (`Σ` children's area × mean of their
+    /// corners = the parent's).
+    #[test]
+    fn the_finer_level_splits_each_panel_in_four_and_keeps_the_velocity_integral() {
+        let mesh = crate::geometry::tests::icosphere(0.1, [0.01, -0.02, 0.03], 2);
+        let n = mesh.len();
+        let taps: Vec<[Corner; 3]> =
+            mesh.panels.iter().map(|p| [0, 1, 2].map(|k| [(p.corners[k], p.normal); 2])).collect();
+        let finer = split_level(&mesh, &taps).expect("a closed surface splits");
+        assert_eq!(finer.mesh.len(), 4 * n);
+        assert_eq!(finer.mesh.vertices.len(), mesh.vertices.len() + 3 * n / 2);
+        assert!((finer.mesh.area() - mesh.area()).abs() <= 1e-12 * mesh.area());
+        assert!(finer.mesh.contains([0.01, -0.02, 0.03]) && !finer.mesh.contains([0.2, 0.0, 0.0]));
+        assert!(2.0 * finer.h <= mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max) + 1e-15);
+
+        // A nodal value f(node) = a smooth function; per panel, the mean of
+        // its corners' tap means (Level::velocity without the bank).
+        let f = |node: usize| {
+            let v = mesh.vertices[node];
+            3.0 * v[0] - v[1] * v[2] + 0.5
+        };
+        let value = |t: &[Corner; 3]| t.iter().map(|&[a, b]| (f(a.0) + f(b.0)) * 0.5).sum::<f64>() / 3.0;
+        for (parent, (p, t)) in mesh.panels.iter().zip(&taps).enumerate() {
+            let children = &finer.taps[4 * parent..4 * parent + 4];
+            let split: f64 =
+                children.iter().zip(&finer.mesh.panels[4 * parent..]).map(|(c, q)| q.area * value(c)).sum();
+            let whole = p.area * value(t);
+            assert!(
+                (split - whole).abs() <= 1e-12 * whole.abs().max(p.area),
+                "panel {parent}: {split} vs {whole}"
+            );
+        }
     }
 }
