@@ -37,7 +37,7 @@ use crate::cluster::Clusters;
 use crate::geometry::{norm, sub, BoundaryMesh, Panel};
 use crate::kernels::{CoupledKernels, Kernels, PointKernel};
 use crate::near::NearField;
-use crate::quadrature::TRIANGLE_3;
+use crate::quadrature::{on_triangle, TRIANGLE_3};
 
 /// Panels closer than this many (cluster radius + panel diameter) to a
 /// cluster's centre are tested at every member centroid; farther ones at
@@ -93,8 +93,7 @@ impl SourcePanel {
     fn new(mesh: &BoundaryMesh, index: usize) -> SourcePanel {
         let p = &mesh.panels[index];
         let t = p.corners.map(|i| mesh.vertices[i]);
-        let points =
-            TRIANGLE_3.map(|(b, _)| [0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k]));
+        let points = TRIANGLE_3.map(|(b, _)| on_triangle(b, t));
         SourcePanel {
             centroid: p.centroid,
             normal: p.normal,
@@ -127,7 +126,7 @@ fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> (Vec<Region>, Vec<Source
     for (p, &c) in clusters.of_panel.iter().enumerate() {
         members[c].push(p);
     }
-    let regions = members
+    let mut regions = members
         .into_iter()
         .map(|m| {
             let area: f64 = m.iter().map(|&p| mesh.panels[p].area).sum();
@@ -148,7 +147,6 @@ fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> (Vec<Region>, Vec<Source
         })
         .collect::<Vec<_>>();
     let mut sources = Vec::with_capacity(mesh.len());
-    let mut regions = regions;
     for region in &mut regions {
         let first = sources.len();
         sources.extend(region.members.iter().map(|&(j, _)| SourcePanel::new(mesh, j)));

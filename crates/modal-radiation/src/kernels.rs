@@ -122,7 +122,7 @@ impl Kernels {
         let t = panel.corners.map(|i| mesh.vertices[i]);
         let mut out = PanelIntegrals::default();
         for (bary, w) in crate::quadrature::TRIANGLE_3 {
-            let y = [0, 1, 2].map(|k| bary[0] * t[0][k] + bary[1] * t[1][k] + bary[2] * t[2][k]);
+            let y = crate::quadrature::on_triangle(bary, t);
             out += self.point(x, nx, y, panel.normal, w * panel.area);
         }
         out
@@ -463,8 +463,7 @@ fn split_and_sum<T: std::ops::AddAssign>(
         return;
     }
     for (bary, w) in TRIANGLE_7 {
-        let y = [0, 1, 2].map(|k| bary[0] * t[0][k] + bary[1] * t[1][k] + bary[2] * t[2][k]);
-        *out += f(y, w * area);
+        *out += f(crate::quadrature::on_triangle(bary, t), w * area);
     }
 }
 
@@ -487,10 +486,7 @@ mod tests {
                 .sum();
         }
         let area = 0.5 * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])));
-        TRIANGLE_7
-            .iter()
-            .map(|(b, w)| f([0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k])) * (w * area))
-            .sum()
+        TRIANGLE_7.iter().map(|(b, w)| f(crate::quadrature::on_triangle(*b, t)) * (w * area)).sum()
     }
 
     /// Largest relative error of the 3-point and the 1-point (centroid)

@@ -95,8 +95,7 @@ pub fn fit(
         let w = (p.area / 3.0).sqrt();
         for (c, bary) in COLLOCATION.iter().enumerate() {
             let row = 3 * j + c;
-            let y = [0, 1, 2]
-                .map(|q| bary[0] * corners[0][q] + bary[1] * corners[1][q] + bary[2] * corners[2][q]);
+            let y = crate::quadrature::on_triangle(*bary, corners);
             for (s, z) in positions.iter().enumerate() {
                 let d = sub(y, *z);
                 let r = norm(d);

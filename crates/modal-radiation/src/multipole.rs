@@ -32,7 +32,7 @@ use faer::c64;
 
 use crate::bem::{Air, SurfaceField};
 use crate::geometry::{norm, sub, BoundaryMesh};
-use crate::quadrature::TRIANGLE_3;
+use crate::quadrature::{on_triangle, TRIANGLE_3};
 use crate::special::{lm_index, spherical_bessel_j, spherical_hankel, spherical_harmonics, Harmonics};
 
 /// Extra degrees above `kR` in the fit (the near-field tail at
@@ -149,9 +149,9 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
             let (mut plus, mut minus) = (vec![zero; ncoef], vec![zero; ncoef]);
             for (o, p) in chunk.iter().enumerate() {
                 let j = c * CHUNK + o;
-                let [a, b, cc] = p.corners.map(|i| mesh.vertices[i]);
+                let t = p.corners.map(|i| mesh.vertices[i]);
                 for (bary, w) in TRIANGLE_3 {
-                    let y = [0, 1, 2].map(|q| bary[0] * a[q] + bary[1] * b[q] + bary[2] * cc[q]);
+                    let y = on_triangle(bary, t);
                     regular([0, 1, 2].map(|q| y[q] + delta * p.normal[q]), &mut plus);
                     regular([0, 1, 2].map(|q| y[q] - delta * p.normal[q]), &mut minus);
                     for (u, v) in plus.iter_mut().zip(minus.iter_mut()) {

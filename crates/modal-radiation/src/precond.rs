@@ -35,7 +35,7 @@ struct Block {
     inverse: Vec<c64>,
 }
 
-/// The factorised block-diagonal part of `A` (module doc).
+/// The inverted block-diagonal part of `A` (module doc).
 #[derive(Clone, Debug)]
 pub struct BlockJacobi {
     n: usize,
@@ -43,7 +43,7 @@ pub struct BlockJacobi {
 }
 
 impl BlockJacobi {
-    /// Factorises the blocks `(unknowns, A restricted to them, row-major)`,
+    /// Inverts the blocks `(unknowns, A restricted to them, row-major)`,
     /// which must partition `0..n`. `None` when a block is singular or not
     /// finite (GMRES's caller then factorises the whole system).
     pub fn new<'a>(

@@ -55,6 +55,13 @@ fn legendre_and_derivative(n: usize, x: f64) -> (f64, f64) {
     (p1, d)
 }
 
+/// The point of triangle `t` with barycentric coordinates `b`:
+/// `b₀ t₀ + b₁ t₁ + b₂ t₂` [m].
+#[inline]
+pub fn on_triangle(b: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k])
+}
+
 /// Strang–Fix 3-point rule at the edge-interior points `(2/3, 1/6, 1/6)`,
 /// exact for polynomials of degree 2, weights summing to 1.
 pub const TRIANGLE_3: [([f64; 3], f64); 3] = [
