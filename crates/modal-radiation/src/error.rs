@@ -84,6 +84,19 @@ pub enum RadiationError {
         /// Distance the point must keep from the surface [m].
         tolerance_m: f64,
     },
+    /// A field point so far away that the kernels' `r²` would overflow
+    /// ([`crate::geometry::MAX_FIELD_COORDINATE_M`]).
+    #[error("point ({x:e}, {y:e}, {z:e}) m is out of range: each coordinate must be within ±{max_m:e} m (farther, r² overflows)")]
+    PointOutOfRange {
+        /// x [m].
+        x: f64,
+        /// y [m].
+        y: f64,
+        /// z [m].
+        z: f64,
+        /// The largest coordinate magnitude accepted [m].
+        max_m: f64,
+    },
     /// The dense solve failed (singular system).
     #[error("the boundary-element system at {frequency_hz} Hz is singular")]
     Singular {

@@ -87,6 +87,11 @@ pub(crate) fn norm(a: [f64; 3]) -> f64 {
 /// shows just outside it.
 pub const ON_SURFACE_RATIO: f64 = 5e-3;
 
+/// Largest coordinate magnitude of a field point [m]: the kernels square
+/// the distance, which overflows f64 beyond ≈ 1.3·10¹⁵⁴ m (the pressure
+/// then comes out NaN); 10¹⁵⁰ m keeps every intermediate finite.
+pub const MAX_FIELD_COORDINATE_M: f64 = 1e150;
+
 /// Where a field point lies relative to the closed surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FieldPoint {
@@ -289,9 +294,13 @@ impl FieldPoint {
         }
     }
 
-    /// `Ok` outside; for the point `x` on the surface or inside, the error.
+    /// `Ok` outside; for the point `x` on the surface, inside, or beyond
+    /// [`MAX_FIELD_COORDINATE_M`], the error.
     pub fn check(self, x: [f64; 3]) -> Result<(), RadiationError> {
         let [x, y, z] = x;
+        if [x, y, z].iter().any(|c| c.is_nan() || c.abs() > MAX_FIELD_COORDINATE_M) {
+            return Err(RadiationError::PointOutOfRange { x, y, z, max_m: MAX_FIELD_COORDINATE_M });
+        }
         match self {
             FieldPoint::Outside => Ok(()),
             FieldPoint::OnSurface { distance_m, tolerance_m } => {
@@ -337,6 +346,20 @@ pub(crate) mod tests {
         assert!((m.winding_number([1.1, 0.1, -0.2]) - 1.0).abs() < 1e-9);
         assert!(m.winding_number([2.0, 0.1, -0.2]).abs() < 1e-9);
         assert!(m.contains([1.0, 0.0, 0.0]) && !m.contains([0.0, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn points_beyond_the_coordinate_range_are_refused_not_evaluated() {
+        let m = icosphere(0.5, [1.0, 0.0, 0.0], 1);
+        assert_eq!(m.check_field_point([-0.9e150, 1e149, 0.0]), Ok(()));
+        for x in [[2e150, 0.0, 0.0], [0.0, -1e300, 0.0], [0.0, 0.0, f64::NAN]] {
+            match m.check_field_point(x) {
+                Err(RadiationError::PointOutOfRange { max_m, .. }) => {
+                    assert_eq!(max_m, MAX_FIELD_COORDINATE_M)
+                }
+                other => panic!("{x:?}: {other:?}"),
+            }
+        }
     }
 
     /// Deterministic uniform numbers in [0, 1) (64-bit LCG, top 53 bits).
