@@ -439,7 +439,7 @@ mod tests {
         for f in 0..2 {
             let diff: f64 = (0..n).map(|i| (it[(i, f)] - lu[(i, f)]).norm_sqr()).sum::<f64>().sqrt();
             let size: f64 = (0..n).map(|i| lu[(i, f)].norm_sqr()).sum::<f64>().sqrt();
-            // ACA's 1e-6 on each block plus GMRES's tolerance, times cond(A).
+            // ACA's ε on each block plus GMRES's tolerance, times cond(A).
             assert!(diff < 1e-4 * size, "field {f}: relative difference {}", diff / size);
         }
     }

@@ -38,9 +38,9 @@
 //! the fetched columns, and a block ACA gives up on is completed dense
 //! from them (it gave up after `m/2` rows and as many columns, a quarter
 //! of its entries left). Measured on the demo bowl at 5 296 Hz (5 707
-//! unknowns): 5 485 of the 6 488 admissible blocks give up (ranks ≈ 23 of
-//! 32 even by SVD at `ε`), 36 % of the stored entries; evaluating them
-//! twice had cost 17 % of the assembly.
+//! unknowns, at `ε = 10⁻⁶`): 5 485 of the 6 488 admissible blocks give up
+//! (ranks ≈ 23 of 32 even by SVD at `ε`), 36 % of the stored entries;
+//! evaluating them twice had cost 17 % of the assembly.
 //!
 //! ACA's rank overshoots the SVD's: each low-rank `A` block is then
 //! recompressed to `ε` ([`crate::lowrank`]; the right-hand side is taken
@@ -71,8 +71,28 @@ pub const LEAF_SIZE: usize = 32;
 /// 48–53 % at ranks up to 144 and no faster.
 pub const ETA: f64 = 2.0;
 
-/// Relative Frobenius error `ε` at which ACA stops on each block.
-pub const ACA_TOLERANCE: f64 = 1e-6;
+/// Relative Frobenius error `ε` at which ACA stops on each block (and to
+/// which its low-rank blocks are recompressed).
+///
+/// Set by the levels it leaves, not by the matrix: every playable mode of
+/// the demo's three banks (72 modes, 40 points at 0.3 m), against
+/// `ε = 10⁻⁶`, largest change at the points within 40 dB of a mode's
+/// loudest and user time of the three objects (release, load ≤ 2):
+///
+/// | `ε` | bowl / bar / block max | user s |
+/// |---|---|---|
+/// | 10⁻⁶ | (reference) | 461 |
+/// | 10⁻⁴ | 0.034 / 0.001 / 0.004 dB | 396 |
+/// | 3·10⁻⁴ | 0.051 / 0.007 / 0.009 dB | 363 |
+/// | 10⁻³ | 0.235 / 0.026 / 0.030 dB | 320 |
+///
+/// 3·10⁻⁴ keeps every change under 0.1 dB, a tenth of the cross-check's
+/// median criterion and a fraction of the discretization's own error
+/// (0.3–0.4 dB median against bempp), with median changes ≤ 0.001 dB and
+/// radiated power ≤ 0.0001 dB; 10⁻³ does not. (Quiet points are what is
+/// left of the surface's contributions cancelling, so a block error `ε`
+/// reaches them amplified.)
+pub const ACA_TOLERANCE: f64 = 3e-4;
 
 /// One node of the cluster tree: unknowns `perm[start..end]`, the box of
 /// their spheres, its children.
@@ -455,8 +475,10 @@ pub(crate) mod system_tests {
     /// (an ellipsoid, 1 280 panels, 6 kHz, two fields): product
     /// with a fixed vector, diagonal and right-hand sides; and the same bits
     /// on one thread and on three. Measured (`cargo test -p modal-radiation
-    /// --lib compressed_system -- --nocapture`): 1 101 unknowns, product
-    /// within 1e-8, right-hand sides within 1e-7.
+    /// --lib compressed_system -- --nocapture`): 1 101 unknowns; at
+    /// `ε = 10⁻⁶` product within 1e-8, right-hand sides within 1e-7; at
+    /// `ε = 3·10⁻⁴` within 3.5e-6 and 2.2e-5. Each block is within `ε` of
+    /// its own norm (Frobenius), so the whole within `ε` of the matrix's.
     #[test]
     fn compressed_system_matches_the_dense_one() {
         let system = EllipsoidSystem::new();
@@ -484,7 +506,7 @@ pub(crate) mod system_tests {
         };
         let b = rel(&rhs, &hrhs);
         eprintln!("n {n}, {stats:?}: product relative error {product:.2e}, right-hand sides {b:.2e}");
-        assert!(product < 1e-5 && b < 1e-5, "product {product}, right-hand sides {b}");
+        assert!(product < ACA_TOLERANCE && b < ACA_TOLERANCE, "product {product}, right-hand sides {b}");
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
