@@ -40,7 +40,8 @@
 //! singularity and depend on the geometry alone: integrated once per
 //! object by the adaptive rule, they serve every frequency. What is left
 //! is bounded and smooth on the panel (`x` off it), so the plain 7-point
-//! rule integrates it ([`Kernels::remainder`]; split while `k·h > 1`). The
+//! rule integrates it ([`Kernels::remainder`]; split while `k·h >`
+//! [`REMAINDER_MAX_KH`]). The
 //! brackets are formed directly: their rounding is ≈ 10⁻¹⁶ of the static
 //! term, whatever `kr`.
 
@@ -54,6 +55,17 @@ use crate::quadrature::TRIANGLE_7;
 pub const NEAR_RATIO: f64 = 2.0;
 /// Deepest recursive split (4^depth leaves).
 pub const MAX_DEPTH: usize = 7;
+/// The near remainder's (sub)panel is split in four while `k·h` exceeds
+/// this. The remainder varies on the scale `1/k`; the 7-point rule's error
+/// on it against a remainder on 4⁶ sub-panels, largest over the four
+/// kernels relative to each one's scale (test
+/// `static_part_plus_remainder_is_the_whole_kernel`): 2.3·10⁻⁴ at
+/// `k·h = 1`, 1.2·10⁻³ at 1.5, 3.5·10⁻³ at 2, inside the 6·10⁻³ that the
+/// far pairs' 3-point rule is allowed at the same `k·h`
+/// ([`crate::assembly::THREE_POINT_MAX_KH`]). Splitting from `k·h = 1`
+/// instead cost 9 % more time on the demo bowl's capped groups (15.7 and
+/// 18.8 kHz, paired runs) for level changes ≤ 0.0006 dB.
+pub const REMAINDER_MAX_KH: f64 = 2.0;
 /// Gauss–Legendre points per edge in the singular (self) integrals.
 const SELF_POINTS: usize = 24;
 
@@ -171,11 +183,12 @@ impl Kernels {
     }
 
     /// `∫` of the kernels minus their `k⁰` and `k²` terms (module doc) by
-    /// the 7-point rule, the panel split in four while `k·h > 1`.
+    /// the 7-point rule, the panel split in four while `k·h >`
+    /// [`REMAINDER_MAX_KH`].
     pub fn remainder(&self, mesh: &BoundaryMesh, panel: &Panel, x: [f64; 3], nx: [f64; 3]) -> PanelIntegrals {
         let k = self.k;
         let ny = panel.normal;
-        let split = |_: [f64; 3], diam: f64, depth: usize| depth < MAX_DEPTH && k * diam > 1.0;
+        let split = |_: [f64; 3], diam: f64, depth: usize| depth < MAX_DEPTH && k * diam > REMAINDER_MAX_KH;
         let f = |y: [f64; 3], w: f64| {
             let d = sub(y, x);
             let r2 = dot(d, d);
@@ -615,13 +628,15 @@ mod tests {
     /// Measured (`cargo test -p modal-radiation --lib static_part -- --nocapture`):
     /// the static coefficients plus the 7-point remainder against the adaptive
     /// rule on the whole kernel (k·d ≤ 1, where that rule is the reference),
-    /// and against a remainder on 4⁶ sub-panels (k·d up to 4).
+    /// and against a remainder on 4⁶ sub-panels (k·d up to 4): 2.3e-4 at
+    /// k·d = 1, 1.2e-3 at 1.5, 3.5e-3 at 2 (unsplit), 6.9e-4 at 3 and 1.8e-3
+    /// at 4 (split once).
     #[test]
     fn static_part_plus_remainder_is_the_whole_kernel() {
         let mesh = one_panel([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.003, 0.008, 0.0]]);
         let p = &mesh.panels[0];
         let laplace = Kernels::new(0.0);
-        for kd in [0.0, 0.3, 1.0, 2.0, 4.0] {
+        for kd in [0.0, 0.3, 1.0, 1.5, 2.0, 3.0, 4.0] {
             let kern = Kernels::new(kd / p.diameter);
             let (mut whole, mut fine) = (0.0f64, 0.0f64);
             for (x, nx) in near_points(p) {
@@ -656,7 +671,9 @@ mod tests {
             eprintln!(
                 "k·d {kd}: against the adaptive rule {whole:.2e}, against the deep remainder {fine:.2e}"
             );
-            assert!(whole < 1e-3 && fine < 1e-3, "k·d {kd}: {whole} {fine}");
+            // Unsplit up to REMAINDER_MAX_KH: the 3-point far rule's 6e-3 there.
+            let budget = if kd <= 1.0 { 1e-3 } else { 6e-3 };
+            assert!(whole < 1e-3 && fine < budget, "k·d {kd}: {whole} {fine}");
         }
     }
 
