@@ -125,18 +125,6 @@ pub struct Solution {
     pub residual: f64,
 }
 
-/// Solves `A x = b` (`a` row-major `n × n`) to [`TOLERANCE`],
-/// preconditioned by the diagonal. `None` when it does not converge within
-/// [`MAX_ITERATIONS`] or meets a zero diagonal (the caller then factorises
-/// instead).
-pub fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
-    let n = b.len();
-    debug_assert_eq!(a.len(), n * n);
-    let diagonal: Vec<c64> = (0..n).map(|i| a[i * n + i]).collect();
-    let pc = BlockJacobi::diagonal(&diagonal)?;
-    solve_many(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| product(a, xs, ys), &[b])?.pop()
-}
-
 /// Solves `A x = b_f` for every right-hand side `bs[f]`, right-
 /// preconditioned by `pc` (`A M⁻¹ u = b`, `x = M⁻¹ u`), for an operator
 /// given by its product `apply(xs, ys)`: `ys[v] = A xs[v]` (for instance a
@@ -347,6 +335,18 @@ fn givens(a: c64, b: c64) -> (f64, c64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The tests' dense driver of [`solve_many`]: `A x = b` (`a` row-major
+    /// `n × n`) to [`TOLERANCE`], preconditioned by the diagonal; `None`
+    /// when it does not converge within [`MAX_ITERATIONS`] or meets a zero
+    /// diagonal.
+    fn solve(a: &[c64], b: &[c64]) -> Option<Solution> {
+        let n = b.len();
+        debug_assert_eq!(a.len(), n * n);
+        let diagonal: Vec<c64> = (0..n).map(|i| a[i * n + i]).collect();
+        let pc = BlockJacobi::diagonal(&diagonal)?;
+        solve_many(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| product(a, xs, ys), &[b])?.pop()
+    }
 
     /// `y = A x`.
     fn mul(a: &[c64], x: &[c64]) -> Vec<c64> {
