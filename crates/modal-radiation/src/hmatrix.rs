@@ -84,12 +84,12 @@ pub const ETA: f64 = 2.0;
 /// | 10⁻⁶ | (reference) | 461 |
 /// | 10⁻⁴ | 0.034 / 0.001 / 0.004 dB | 396 |
 /// | 3·10⁻⁴ | 0.051 / 0.007 / 0.009 dB | 363 |
-/// | 10⁻³ | 0.235 / 0.026 / 0.030 dB | 320 |
+/// | 10⁻³ | 0.235 / 0.026 / 0.030 dB | 319 |
 ///
 /// 3·10⁻⁴ keeps every change under 0.1 dB, a tenth of the cross-check's
 /// median criterion and a fraction of the discretization's own error
-/// (0.3–0.4 dB median against bempp), with median changes ≤ 0.001 dB and
-/// radiated power ≤ 0.0001 dB; 10⁻³ does not. (Quiet points are what is
+/// (medians 0.05–0.4 dB against bempp), with median changes ≤ 0.001 dB and
+/// radiated power ≤ 0.0002 dB; 10⁻³ does not. (Quiet points are what is
 /// left of the surface's contributions cancelling, so a block error `ε`
 /// reaches them amplified.)
 pub const ACA_TOLERANCE: f64 = 3e-4;
