@@ -408,8 +408,13 @@ struct Panels {
     /// linear along each edge), when that still has at most
     /// [`MAX_DENSE_PANELS`] panels: small objects whose fine panels are
     /// too coarse for their top modes (`k·h > 1`) get one unknown per
-    /// panel at half the size (see [`plan`]).
-    finer: Option<Level>,
+    /// panel at half the size (see [`plan`]). Built by [`Panels::finer`]
+    /// when a frequency group first needs it, so a run of low modes
+    /// never splits.
+    finer: std::sync::OnceLock<Level>,
+    /// Whether the split fits ([`MAX_DENSE_PANELS`]) and is wanted
+    /// (adaptive resolution).
+    finer_fits: bool,
 }
 
 impl Panels {
@@ -436,12 +441,24 @@ impl Panels {
                 .collect();
             Level::new(m, taps)
         });
-        let finer = if adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS {
-            Some(split_level(mesh, &taps)?)
-        } else {
-            None
-        };
-        Ok(Panels { fine: Level::new(mesh.clone(), taps), coarse, finer })
+        Ok(Panels {
+            fine: Level::new(mesh.clone(), taps),
+            coarse,
+            finer: std::sync::OnceLock::new(),
+            finer_fits: adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS,
+        })
+    }
+
+    /// The finer level, split on first use; `None` when it does not fit.
+    fn finer(&self) -> Result<Option<&Level>, RadiationError> {
+        if !self.finer_fits {
+            return Ok(None);
+        }
+        if let Some(level) = self.finer.get() {
+            return Ok(Some(level));
+        }
+        let level = split_level(&self.fine.mesh, &self.fine.taps)?;
+        Ok(Some(self.finer.get_or_init(|| level)))
     }
 }
 
@@ -489,9 +506,9 @@ fn plan<'a>(
     opts: &RadiationOptions,
 ) -> Result<Plan<'a>, RadiationError> {
     let k_eff = k.max(ks);
-    let level = match (&panels.coarse, &panels.finer) {
-        (Some(c), _) if k * c.h <= COARSE_MAX_KH => c,
-        (_, Some(f)) if k * panels.fine.h > UNDER_RESOLVED_KH => f,
+    let level = match &panels.coarse {
+        Some(c) if k * c.h <= COARSE_MAX_KH => c,
+        _ if k * panels.fine.h > UNDER_RESOLVED_KH => panels.finer()?.unwrap_or(&panels.fine),
         _ => &panels.fine,
     };
     if !opts.adaptive_resolution {
