@@ -48,7 +48,7 @@
 use faer::c64;
 
 use crate::geometry::{cross, dot, norm, sub, BoundaryMesh, Panel};
-use crate::quadrature::TRIANGLE_7;
+use crate::quadrature::{on_triangle, TRIANGLE_7};
 
 /// A (sub)panel is split while the point is closer than this many of its
 /// diameters to its centroid.
@@ -134,7 +134,7 @@ impl Kernels {
         let t = panel.corners.map(|i| mesh.vertices[i]);
         let mut out = PanelIntegrals::default();
         for (bary, w) in crate::quadrature::TRIANGLE_3 {
-            let y = crate::quadrature::on_triangle(bary, t);
+            let y = on_triangle(bary, t);
             out += self.point(x, nx, y, panel.normal, w * panel.area);
         }
         out
@@ -476,7 +476,7 @@ fn split_and_sum<T: std::ops::AddAssign>(
         return;
     }
     for (bary, w) in TRIANGLE_7 {
-        *out += f(crate::quadrature::on_triangle(bary, t), w * area);
+        *out += f(on_triangle(bary, t), w * area);
     }
 }
 
@@ -499,7 +499,7 @@ mod tests {
                 .sum();
         }
         let area = 0.5 * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])));
-        TRIANGLE_7.iter().map(|(b, w)| f(crate::quadrature::on_triangle(*b, t)) * (w * area)).sum()
+        TRIANGLE_7.iter().map(|(b, w)| f(on_triangle(*b, t)) * (w * area)).sum()
     }
 
     /// Largest relative error of the 3-point and the 1-point (centroid)

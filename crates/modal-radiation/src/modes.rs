@@ -408,13 +408,11 @@ struct Panels {
     /// linear along each edge), when that still has at most
     /// [`MAX_DENSE_PANELS`] panels: small objects whose fine panels are
     /// too coarse for their top modes (`k·h > 1`) get one unknown per
-    /// panel at half the size (see [`plan`]). Built by [`Panels::finer`]
-    /// when a frequency group first needs it, so a run of low modes
-    /// never splits.
-    finer: std::sync::OnceLock<Level>,
-    /// Whether the split fits ([`MAX_DENSE_PANELS`]) and is wanted
-    /// (adaptive resolution).
-    finer_fits: bool,
+    /// panel at half the size (see [`plan`]). `None` when the split does
+    /// not fit or resolution is not adaptive; otherwise split by
+    /// [`Panels::finer`] when a frequency group first needs it, so a run
+    /// of low modes never splits.
+    finer: Option<std::sync::OnceLock<Level>>,
 }
 
 impl Panels {
@@ -444,21 +442,18 @@ impl Panels {
         Ok(Panels {
             fine: Level::new(mesh.clone(), taps),
             coarse,
-            finer: std::sync::OnceLock::new(),
-            finer_fits: adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS,
+            finer: (adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS).then(std::sync::OnceLock::new),
         })
     }
 
     /// The finer level, split on first use; `None` when it does not fit.
     fn finer(&self) -> Result<Option<&Level>, RadiationError> {
-        if !self.finer_fits {
-            return Ok(None);
-        }
-        if let Some(level) = self.finer.get() {
+        let Some(cell) = &self.finer else { return Ok(None) };
+        if let Some(level) = cell.get() {
             return Ok(Some(level));
         }
         let level = split_level(&self.fine.mesh, &self.fine.taps)?;
-        Ok(Some(self.finer.get_or_init(|| level)))
+        Ok(Some(cell.get_or_init(|| level)))
     }
 }
 
