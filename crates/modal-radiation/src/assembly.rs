@@ -33,6 +33,7 @@
 use faer::c64;
 use rayon::prelude::*;
 
+use crate::batch::SourcePoints;
 use crate::cluster::Clusters;
 use crate::geometry::{norm, sub, BoundaryMesh, Panel};
 use crate::kernels::{CoupledKernels, Kernels, PointKernel};
@@ -180,6 +181,9 @@ pub(crate) struct Assembly<'a> {
     regions: Vec<Region>,
     sources: Vec<SourcePanel>,
     moments: Vec<Vec<Moments>>,
+    /// Whether every `k·r` on the surface is within the batched `sin_cos`'s
+    /// range ([`crate::sincos::MAX_ARGUMENT`]).
+    lanes: bool,
 }
 
 impl<'a> Assembly<'a> {
@@ -220,7 +224,10 @@ impl<'a> Assembly<'a> {
             })
             .collect();
         let coupled = CoupledKernels::new(kern.k(), alpha);
-        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments }
+        // Two surface points are at most twice the radius about the centroid apart.
+        let span = 2.0 * mesh.radius_about(mesh.surface_centroid());
+        let lanes = kern.k() * span <= crate::sincos::MAX_ARGUMENT;
+        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments, lanes }
     }
 
     /// Number of unknowns (clusters).
@@ -253,10 +260,25 @@ impl<'a> Assembly<'a> {
     /// `nrhs` per source: `b_i = Σ_c R(i, c)`). Far source clusters are
     /// summed as points when `aggregate` (module doc).
     pub(crate) fn row(&self, i: usize, sources: &[usize], row: &mut [c64], b: &mut [c64]) {
+        GATHERED.with(|cell| self.row_gathered(i, sources, row, b, &mut cell.borrow_mut()));
+    }
+
+    /// [`Assembly::row`], the panels seen from the cluster's centre by the
+    /// centroid or 3-point rule gathered into `pts` and evaluated in SIMD
+    /// lanes ([`crate::batch`]) after the others.
+    fn row_gathered(
+        &self,
+        i: usize,
+        sources: &[usize],
+        row: &mut [c64],
+        b: &mut [c64],
+        pts: &mut SourcePoints,
+    ) {
         let (k, alpha) = (self.kern.k(), self.alpha);
         let region = &self.regions[i];
         let nrhs = self.q.len().max(1);
-        for ((slot, &c), b) in row.iter_mut().zip(sources).zip(b.chunks_mut(nrhs)) {
+        pts.clear();
+        for (slot_index, ((slot, &c), b)) in row.iter_mut().zip(sources).zip(b.chunks_mut(nrhs)).enumerate() {
             *slot = c64::new(0.0, 0.0);
             b.fill(c64::new(0.0, 0.0));
             let src = &self.regions[c];
@@ -278,11 +300,39 @@ impl<'a> Assembly<'a> {
                 continue;
             }
             for panel in &self.sources[src.span.clone()] {
+                let dist = norm(sub(panel.centroid, region.centre));
+                if self.lanes && !is_near(region, panel, dist) {
+                    match self.off_rule(panel, dist) {
+                        OffRule::Centroid => {
+                            pts.push(panel.centroid, panel.normal, panel.area, slot_index, panel.index);
+                            continue;
+                        }
+                        OffRule::ThreePoint => {
+                            for (y, (_, w)) in panel.points.iter().zip(TRIANGLE_3) {
+                                pts.push(*y, panel.normal, w * panel.area, slot_index, panel.index);
+                            }
+                            continue;
+                        }
+                        OffRule::Adaptive => {}
+                    }
+                }
                 let (a, op) = self.pair(i, panel);
                 *slot += a;
                 for (bf, qf) in b.iter_mut().zip(self.q) {
                     *bf += op * qf[panel.index];
                 }
+            }
+        }
+        if pts.len() == 0 {
+            return;
+        }
+        pts.evaluate(&self.coupled, region.centre, region.normal);
+        for (p, &(slot, panel)) in pts.owner.iter().enumerate() {
+            let (slot, panel) = (slot as usize, panel as usize);
+            let (a, op) = pts.weights(p);
+            row[slot] += a;
+            for (bf, qf) in b[slot * nrhs..(slot + 1) * nrhs].iter_mut().zip(self.q) {
+                *bf += op * qf[panel];
             }
         }
     }
@@ -294,10 +344,7 @@ impl<'a> Assembly<'a> {
         let zero = c64::new(0.0, 0.0);
         let region = &self.regions[i];
         let dist = norm(sub(src.centroid, region.centre));
-        let near = region.members.len() == 1
-            || dist < CLUSTER_NEAR_RATIO * (region.radius + src.diameter)
-            || dist < region.radius + MID_POINT_RATIO * src.diameter;
-        if !near {
+        if !is_near(region, src, dist) {
             return self.off_panel(src, region.centre, region.normal, dist);
         }
         let j = src.index;
@@ -331,16 +378,49 @@ impl<'a> Assembly<'a> {
     /// ([`MID_POINT_RATIO`]) or when far with `k·h ≤`
     /// [`THREE_POINT_MAX_KH`], the adaptive rule otherwise.
     fn off_panel(&self, src: &SourcePanel, x: [f64; 3], nx: [f64; 3], r: f64) -> (c64, c64) {
-        let kh = self.kern.k() * src.diameter;
-        if kh <= 1.0 && r > FAR_POINT_RATIO * src.diameter {
-            self.coupled.point(x, nx, src.centroid, src.normal, src.area)
-        } else if kh <= THREE_POINT_MAX_KH && r > MID_POINT_RATIO * src.diameter {
-            self.coupled.three_point(x, nx, &src.points, src.normal, src.area)
-        } else {
-            let ints = self.kern.panel(self.mesh, &self.mesh.panels[src.index], x, nx);
-            (-ints.dg_dny - self.alpha * ints.d2g, -(ints.g + self.alpha * ints.dg_dnx))
+        match self.off_rule(src, r) {
+            OffRule::Centroid => self.coupled.point(x, nx, src.centroid, src.normal, src.area),
+            OffRule::ThreePoint => self.coupled.three_point(x, nx, &src.points, src.normal, src.area),
+            OffRule::Adaptive => {
+                let ints = self.kern.panel(self.mesh, &self.mesh.panels[src.index], x, nx);
+                (-ints.dg_dny - self.alpha * ints.d2g, -(ints.g + self.alpha * ints.dg_dnx))
+            }
         }
     }
+
+    /// The rule [`Assembly::off_panel`] integrates panel `src` by at
+    /// distance `r` from its centroid.
+    fn off_rule(&self, src: &SourcePanel, r: f64) -> OffRule {
+        let kh = self.kern.k() * src.diameter;
+        if kh <= 1.0 && r > FAR_POINT_RATIO * src.diameter {
+            OffRule::Centroid
+        } else if kh <= THREE_POINT_MAX_KH && r > MID_POINT_RATIO * src.diameter {
+            OffRule::ThreePoint
+        } else {
+            OffRule::Adaptive
+        }
+    }
+}
+
+/// How a panel off its near field is integrated ([`Assembly::off_panel`]).
+enum OffRule {
+    Centroid,
+    ThreePoint,
+    Adaptive,
+}
+
+/// Whether source panel `src` at distance `dist` from `region`'s centre is
+/// tested at every member centroid of `region` ([`CLUSTER_NEAR_RATIO`]);
+/// otherwise at the centre alone.
+fn is_near(region: &Region, src: &SourcePanel, dist: f64) -> bool {
+    region.members.len() == 1
+        || dist < CLUSTER_NEAR_RATIO * (region.radius + src.diameter)
+        || dist < region.radius + MID_POINT_RATIO * src.diameter
+}
+
+thread_local! {
+    /// Each thread's gathered source points, reused from row to row.
+    static GATHERED: std::cell::RefCell<SourcePoints> = std::cell::RefCell::new(SourcePoints::default());
 }
 
 /// The dense system of an [`Assembly`]: row `i` (cluster `i`) of `A` is

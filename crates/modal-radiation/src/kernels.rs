@@ -349,6 +349,21 @@ impl CoupledKernels {
         CoupledKernels { k, alpha, i_alpha: c64::new(-alpha.im, alpha.re) }
     }
 
+    /// The wavenumber `k` [1/m].
+    pub(crate) fn k(&self) -> f64 {
+        self.k
+    }
+
+    /// The coupling `α`.
+    pub(crate) fn alpha(&self) -> c64 {
+        self.alpha
+    }
+
+    /// `iα`.
+    pub(crate) fn i_alpha(&self) -> c64 {
+        self.i_alpha
+    }
+
     /// `(a, op)` of one source point (type doc); `y ≠ x`.
     #[inline]
     pub fn point(&self, x: [f64; 3], nx: [f64; 3], y: [f64; 3], ny: [f64; 3], w: f64) -> (c64, c64) {

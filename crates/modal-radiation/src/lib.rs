@@ -33,6 +33,7 @@
 
 mod aca;
 pub mod assembly;
+mod batch;
 pub mod bem;
 pub mod cluster;
 mod error;
@@ -48,6 +49,7 @@ pub mod near;
 pub mod normals;
 pub mod precond;
 pub mod quadrature;
+mod sincos;
 pub mod special;
 
 pub use bem::{solve, solve_clustered, solve_on, Air, Discretization, Formulation, SurfaceField};
