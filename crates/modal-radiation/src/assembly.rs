@@ -33,12 +33,12 @@
 use faer::c64;
 use rayon::prelude::*;
 
-use crate::batch::SourcePoints;
+use crate::batch::{Formula, SourcePoints};
 use crate::cluster::Clusters;
 use crate::geometry::{norm, sub, BoundaryMesh, Panel};
-use crate::kernels::{CoupledKernels, Kernels, PointKernel};
+use crate::kernels::{CoupledKernels, Kernels, PointKernel, REMAINDER_MAX_KH};
 use crate::near::NearField;
-use crate::quadrature::{on_triangle, TRIANGLE_3};
+use crate::quadrature::{on_triangle, TRIANGLE_3, TRIANGLE_7};
 
 /// Panels closer than this many (cluster radius + panel diameter) to a
 /// cluster's centre are tested at every member centroid; farther ones at
@@ -263,21 +263,15 @@ impl<'a> Assembly<'a> {
         GATHERED.with(|cell| self.row_gathered(i, sources, row, b, &mut cell.borrow_mut()));
     }
 
-    /// [`Assembly::row`], the panels seen from the cluster's centre by the
-    /// centroid or 3-point rule gathered into `pts` and evaluated in SIMD
-    /// lanes ([`crate::batch`]) after the others.
-    fn row_gathered(
-        &self,
-        i: usize,
-        sources: &[usize],
-        row: &mut [c64],
-        b: &mut [c64],
-        pts: &mut SourcePoints,
-    ) {
+    /// [`Assembly::row`]: the source points of the centroid, 3-point and
+    /// near-remainder rules are gathered into `g` and evaluated in SIMD
+    /// lanes ([`crate::batch`]) after the rest of the row.
+    fn row_gathered(&self, i: usize, sources: &[usize], row: &mut [c64], b: &mut [c64], g: &mut Gathered) {
         let (k, alpha) = (self.kern.k(), self.alpha);
         let region = &self.regions[i];
         let nrhs = self.q.len().max(1);
-        pts.clear();
+        g.coupled.clear();
+        g.remainder.clear();
         for (slot_index, ((slot, &c), b)) in row.iter_mut().zip(sources).zip(b.chunks_mut(nrhs)).enumerate() {
             *slot = c64::new(0.0, 0.0);
             b.fill(c64::new(0.0, 0.0));
@@ -300,35 +294,26 @@ impl<'a> Assembly<'a> {
                 continue;
             }
             for panel in &self.sources[src.span.clone()] {
-                let dist = norm(sub(panel.centroid, region.centre));
-                if self.lanes && !is_near(region, panel, dist) {
-                    match self.off_rule(panel, dist) {
-                        OffRule::Centroid => {
-                            pts.push(panel.centroid, panel.normal, panel.area, slot_index, panel.index);
-                            continue;
-                        }
-                        OffRule::ThreePoint => {
-                            for (y, (_, w)) in panel.points.iter().zip(TRIANGLE_3) {
-                                pts.push(*y, panel.normal, w * panel.area, slot_index, panel.index);
-                            }
-                            continue;
-                        }
-                        OffRule::Adaptive => {}
-                    }
-                }
-                let (a, op) = self.pair(i, panel);
+                let (a, op) = self.pair(i, panel, slot_index, g);
                 *slot += a;
                 for (bf, qf) in b.iter_mut().zip(self.q) {
                     *bf += op * qf[panel.index];
                 }
             }
         }
+        self.add_gathered(&mut g.coupled, Formula::Coupled, row, b);
+        self.add_gathered(&mut g.remainder, Formula::Remainder, row, b);
+    }
+
+    /// Evaluates the gathered points `pts` by `formula` and adds each to
+    /// its row entry and right-hand-side parts.
+    fn add_gathered(&self, pts: &mut SourcePoints, formula: Formula, row: &mut [c64], b: &mut [c64]) {
         if pts.len() == 0 {
             return;
         }
-        pts.evaluate(&self.coupled, region.centre, region.normal);
-        for (p, &(slot, panel)) in pts.owner.iter().enumerate() {
-            let (slot, panel) = (slot as usize, panel as usize);
+        let nrhs = self.q.len().max(1);
+        pts.evaluate(&self.coupled, formula, !self.lanes);
+        for (p, (slot, panel)) in pts.owners().enumerate() {
             let (a, op) = pts.weights(p);
             row[slot] += a;
             for (bf, qf) in b[slot * nrhs..(slot + 1) * nrhs].iter_mut().zip(self.q) {
@@ -337,34 +322,39 @@ impl<'a> Assembly<'a> {
         }
     }
 
-    /// Panel `src`'s weights in row `i`, integrated on its own: its term of
+    /// Panel `src`'s weights in row `i` (`slot` in the row): its term of
     /// `A_ic` (`c` its cluster) and its factor `op` in `b_i += op·q_j`.
-    fn pair(&self, i: usize, src: &SourcePanel) -> (c64, c64) {
+    /// Returns the part integrated here; the points of the fixed rules
+    /// go to `g`, to be added by [`Assembly::add_gathered`].
+    fn pair(&self, i: usize, src: &SourcePanel, slot: usize, g: &mut Gathered) -> (c64, c64) {
         let (kern, mesh, alpha) = (self.kern, self.mesh, self.alpha);
         let zero = c64::new(0.0, 0.0);
         let region = &self.regions[i];
         let dist = norm(sub(src.centroid, region.centre));
         if !is_near(region, src, dist) {
-            return self.off_panel(src, region.centre, region.normal, dist);
+            return self.off_panel(src, (region.centre, region.normal), dist, 1.0, slot, g);
         }
         let j = src.index;
         let pj = &mesh.panels[j];
         let (mut a, mut op) = (zero, zero);
         for &(t, w) in &region.members {
             let pt = &mesh.panels[t];
+            let seen_from = (pt.centroid, pt.normal);
             let (panels, statics) = self.near_field.row(t);
-            let ints = if t == j {
-                kern.self_integrals(mesh, pj)
+            let (ints, half) = if t == j {
+                (kern.self_integrals(mesh, pj), 0.5)
             } else if let Ok(s) = panels.binary_search(&(j as u32)) {
-                kern.near(mesh, pj, pt.centroid, pt.normal, &statics[s])
+                let (da, dop) = self.near_remainder(src, seen_from, w, slot, g);
+                a += da;
+                op += dop;
+                (statics[s].at(kern.k()), 0.0)
             } else {
                 let (da, dop) =
-                    self.off_panel(src, pt.centroid, pt.normal, norm(sub(src.centroid, pt.centroid)));
-                a += da * w;
-                op += dop * w;
+                    self.off_panel(src, seen_from, norm(sub(src.centroid, pt.centroid)), w, slot, g);
+                a += da;
+                op += dop;
                 continue;
             };
-            let half = if t == j { 0.5 } else { 0.0 };
             a += (c64::new(half, 0.0) - ints.dg_dny - alpha * ints.d2g) * w;
             // −(L + α(½ + K')) q_j
             op -= (ints.g + alpha * (ints.dg_dnx + half)) * w;
@@ -372,24 +362,66 @@ impl<'a> Assembly<'a> {
         (a, op)
     }
 
-    /// `(a, op)` of panel `src` seen from `x` (normal `nx`) at distance `r`
-    /// from its centroid, off its near field: one centroid point when far
-    /// ([`FAR_POINT_RATIO`]) and `k·h ≤ 1`, three points at mid range
-    /// ([`MID_POINT_RATIO`]) or when far with `k·h ≤`
-    /// [`THREE_POINT_MAX_KH`], the adaptive rule otherwise.
-    fn off_panel(&self, src: &SourcePanel, x: [f64; 3], nx: [f64; 3], r: f64) -> (c64, c64) {
+    /// `w ×` the remainder term of near panel `src` seen from `seen_from`
+    /// (point, normal): its seven points gathered, or when the remainder
+    /// must be split (`k·h >` [`REMAINDER_MAX_KH`]) integrated here.
+    fn near_remainder(
+        &self,
+        src: &SourcePanel,
+        seen_from: ([f64; 3], [f64; 3]),
+        w: f64,
+        slot: usize,
+        g: &mut Gathered,
+    ) -> (c64, c64) {
+        let panel = &self.mesh.panels[src.index];
+        if self.kern.k() * panel.diameter > REMAINDER_MAX_KH {
+            let ints = self.kern.remainder(self.mesh, panel, seen_from.0, seen_from.1);
+            return ((-ints.dg_dny - self.alpha * ints.d2g) * w, -(ints.g + self.alpha * ints.dg_dnx) * w);
+        }
+        let t = panel.corners.map(|c| self.mesh.vertices[c]);
+        for (b, wq) in TRIANGLE_7 {
+            g.remainder.push(seen_from, on_triangle(b, t), src.normal, w * wq * src.area, slot, src.index);
+        }
+        (c64::new(0.0, 0.0), c64::new(0.0, 0.0))
+    }
+
+    /// `w × (a, op)` of panel `src` seen from `seen_from` (point, normal)
+    /// at distance `r` from its centroid, off its near field, by
+    /// [`Assembly::off_rule`]: the points of the centroid and 3-point rules
+    /// gathered, the adaptive rule integrated here.
+    fn off_panel(
+        &self,
+        src: &SourcePanel,
+        seen_from: ([f64; 3], [f64; 3]),
+        r: f64,
+        w: f64,
+        slot: usize,
+        g: &mut Gathered,
+    ) -> (c64, c64) {
+        let zero = c64::new(0.0, 0.0);
         match self.off_rule(src, r) {
-            OffRule::Centroid => self.coupled.point(x, nx, src.centroid, src.normal, src.area),
-            OffRule::ThreePoint => self.coupled.three_point(x, nx, &src.points, src.normal, src.area),
+            OffRule::Centroid => {
+                g.coupled.push(seen_from, src.centroid, src.normal, w * src.area, slot, src.index);
+                (zero, zero)
+            }
+            OffRule::ThreePoint => {
+                for (y, (_, wq)) in src.points.iter().zip(TRIANGLE_3) {
+                    g.coupled.push(seen_from, *y, src.normal, w * wq * src.area, slot, src.index);
+                }
+                (zero, zero)
+            }
             OffRule::Adaptive => {
-                let ints = self.kern.panel(self.mesh, &self.mesh.panels[src.index], x, nx);
-                (-ints.dg_dny - self.alpha * ints.d2g, -(ints.g + self.alpha * ints.dg_dnx))
+                let ints = self.kern.panel(self.mesh, &self.mesh.panels[src.index], seen_from.0, seen_from.1);
+                ((-ints.dg_dny - self.alpha * ints.d2g) * w, -(ints.g + self.alpha * ints.dg_dnx) * w)
             }
         }
     }
 
     /// The rule [`Assembly::off_panel`] integrates panel `src` by at
-    /// distance `r` from its centroid.
+    /// distance `r` from its centroid: its centroid alone when far
+    /// ([`FAR_POINT_RATIO`]) and `k·h ≤ 1`, three points at mid range
+    /// ([`MID_POINT_RATIO`]) or when far with `k·h ≤`
+    /// [`THREE_POINT_MAX_KH`], the adaptive rule otherwise.
     fn off_rule(&self, src: &SourcePanel, r: f64) -> OffRule {
         let kh = self.kern.k() * src.diameter;
         if kh <= 1.0 && r > FAR_POINT_RATIO * src.diameter {
@@ -402,7 +434,7 @@ impl<'a> Assembly<'a> {
     }
 }
 
-/// How a panel off its near field is integrated ([`Assembly::off_panel`]).
+/// How a panel off its near field is integrated ([`Assembly::off_rule`]).
 enum OffRule {
     Centroid,
     ThreePoint,
@@ -418,9 +450,17 @@ fn is_near(region: &Region, src: &SourcePanel, dist: f64) -> bool {
         || dist < region.radius + MID_POINT_RATIO * src.diameter
 }
 
+/// A row's gathered source points ([`crate::batch`]): of the coupled
+/// kernels (centroid and 3-point rules) and of the near remainders.
+#[derive(Default)]
+struct Gathered {
+    coupled: SourcePoints,
+    remainder: SourcePoints,
+}
+
 thread_local! {
     /// Each thread's gathered source points, reused from row to row.
-    static GATHERED: std::cell::RefCell<SourcePoints> = std::cell::RefCell::new(SourcePoints::default());
+    static GATHERED: std::cell::RefCell<Gathered> = std::cell::RefCell::new(Gathered::default());
 }
 
 /// The dense system of an [`Assembly`]: row `i` (cluster `i`) of `A` is

@@ -1,24 +1,31 @@
-//! The Burton–Miller weights of many source points seen from one point,
-//! evaluated in SIMD lanes.
+//! The Burton–Miller weights of many source points, each seen from its
+//! own point, evaluated in SIMD lanes.
 //!
-//! A row of the system ([`crate::assembly`]) sees most of its source
-//! panels from one point (its cluster's centre) by the centroid or the
-//! 3-point rule. Each such point costs the formula of
-//! [`CoupledKernels::point`]:
+//! A row of the system ([`crate::assembly`]) sees most source panels from
+//! its cluster's centre or a member centroid by the centroid or the
+//! 3-point rule, and its near pairs add a 7-point remainder. Each such
+//! point costs one of two formulas, with `G = e^{ikr}/(4πr)`, `u = 1/r²`,
+//! `t = ikr − 1`, `αt = −α + kr·iα`, `αs = (3 − k²r²)α − 3kr·iα`:
 //!
-//! `a = −G w u [t (d·n_y) − αt (n_x·n_y) − αs (d·n_x)(d·n_y) u]`,
-//! `op = −G w [1 − αt (d·n_x) u]`,
+//! - **coupled** ([`CoupledKernels::point`]):
+//!   `a = −G w u [t (d·n_y) − αt (n_x·n_y) − αs (d·n_x)(d·n_y) u]`,
+//!   `op = −G w [1 − αt (d·n_x) u]`;
+//! - **remainder** (the kernels minus their `k⁰`, `k²` terms,
+//!   [`crate::kernels::Kernels::remainder`]): `a = −(R_{∂G/∂n_y} + α R_{∂²G})`,
+//!   `op = −(R_G + α R_{∂G/∂n_x})` with `e = e^{ikr}`, `h = k²r²/2`,
+//!   `R_G = (e − 1) w/(4πr)`, `R_{∂G/∂n_y} = −R_{∂G/∂n_x}·(d·n_y)/(d·n_x) =
+//!   [e(ikr − 1) + 1 + h](d·n_y) w/(4πr³)`,
+//!   `R_{∂²G} = {[e(1 − ikr) − 1 − h] n_x·n_y − [e(3 − 3ikr − k²r²) − 3 − h]
+//!   (d·n_x)(d·n_y)/r²} w/(4πr³)`.
 //!
-//! `G = e^{ikr}/(4πr)`, `u = 1/r²`, `t = ikr − 1`, `αt = −α + kr·iα`,
-//! `αs = (3 − k²r²)α − 3kr·iα`. Called point by point, the libm `sincos`
-//! call and the scalar complex products were ≈ 40 % of a capped
-//! high-frequency solve. Here the points are gathered into columns
-//! (structure of arrays) and one loop without calls or branches evaluates
-//! them all, with [`crate::sincos`] in place of libm, so the compiler
-//! vectorizes it: two lanes on any x86-64, four where the CPU has AVX2
-//! (chosen at run time). Each lane does the same IEEE operations in the
-//! same order either way, so the result does not depend on the lane width
-//! (nor on the thread count).
+//! Called point by point, the libm `sincos` call and the scalar complex
+//! products were ≈ 40 % of a capped high-frequency solve. Here the points
+//! are gathered into columns (structure of arrays) and one loop without
+//! calls or branches evaluates them all, with [`crate::sincos`] in place
+//! of libm, so the compiler vectorizes it: two lanes on any x86-64, four
+//! where the CPU has AVX2 (chosen at run time). Each lane does the same
+//! IEEE operations in the same order either way, so the result does not
+//! depend on the lane width (nor on the thread count).
 
 use faer::c64;
 
@@ -27,45 +34,74 @@ use crate::sincos::sin_cos;
 
 const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 
-/// Source points gathered for one row: position, normal and weight, the
-/// row slot and panel they belong to, and after [`SourcePoints::evaluate`]
-/// their weights `a` and `op`.
+/// Which kernels a batch of points evaluates (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Formula {
+    /// The whole coupled kernels.
+    Coupled,
+    /// The near pairs' remainder.
+    Remainder,
+}
+
+/// Source points gathered for one row: the point and normal each is seen
+/// from, its position, normal and weight, the row slot and panel it
+/// belongs to, and after [`SourcePoints::evaluate`] its weights `a`, `op`.
 #[derive(Default)]
 pub(crate) struct SourcePoints {
-    y: [Vec<f64>; 3],
-    n: [Vec<f64>; 3],
-    w: Vec<f64>,
-    /// Which entry of the row, and which mesh panel, each point adds to.
-    pub(crate) owner: Vec<(u32, u32)>,
+    points: Vec<SourcePoint>,
+    /// Where each chunk is moved into columns, kept from call to call.
+    columns: Option<Box<Columns>>,
+    /// `a` and `op` of the points (real, imaginary), first `len()` valid.
     a: [Vec<f64>; 2],
     op: [Vec<f64>; 2],
 }
 
+/// One gathered point, stored as it comes (one push per point); the
+/// evaluation moves chunks of them into columns.
+#[derive(Clone, Copy)]
+struct SourcePoint {
+    x: [f64; 3],
+    nx: [f64; 3],
+    y: [f64; 3],
+    n: [f64; 3],
+    w: f64,
+    slot: u32,
+    panel: u32,
+}
+
+/// Points moved into columns at a time: a chunk's columns stay in L1.
+const CHUNK: usize = 64;
+
 impl SourcePoints {
     /// Empties the gathered points, keeping their storage.
     pub(crate) fn clear(&mut self) {
-        for v in self.y.iter_mut().chain(&mut self.n) {
-            v.clear();
-        }
-        self.w.clear();
-        self.owner.clear();
+        self.points.clear();
     }
 
     /// Number of gathered points.
     pub(crate) fn len(&self) -> usize {
-        self.w.len()
+        self.points.len()
     }
 
     /// Adds a source point `y` (normal `n`, quadrature weight `w`) of panel
-    /// `panel`, to be summed into row entry `slot`.
+    /// `panel` seen from `x` (normal `nx`), to be summed into row entry
+    /// `slot`.
     #[inline]
-    pub(crate) fn push(&mut self, y: [f64; 3], n: [f64; 3], w: f64, slot: usize, panel: usize) {
-        for k in 0..3 {
-            self.y[k].push(y[k]);
-            self.n[k].push(n[k]);
-        }
-        self.w.push(w);
-        self.owner.push((slot as u32, panel as u32));
+    pub(crate) fn push(
+        &mut self,
+        (x, nx): ([f64; 3], [f64; 3]),
+        y: [f64; 3],
+        n: [f64; 3],
+        w: f64,
+        slot: usize,
+        panel: usize,
+    ) {
+        self.points.push(SourcePoint { x, nx, y, n, w, slot: slot as u32, panel: panel as u32 });
+    }
+
+    /// The row entry and mesh panel of each gathered point, in order.
+    pub(crate) fn owners(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.points.iter().map(|p| (p.slot as usize, p.panel as usize))
     }
 
     /// `(a, op)` of gathered point `p` (after [`SourcePoints::evaluate`]).
@@ -74,24 +110,99 @@ impl SourcePoints {
         (c64::new(self.a[0][p], self.a[1][p]), c64::new(self.op[0][p], self.op[1][p]))
     }
 
-    /// Evaluates every gathered point's `(a, op)` seen from `x` (normal
-    /// `nx`), no point at `x`, every `k·r` within
-    /// [`crate::sincos::MAX_ARGUMENT`].
-    pub(crate) fn evaluate(&mut self, kernels: &CoupledKernels, x: [f64; 3], nx: [f64; 3]) {
+    /// Evaluates every gathered point's `(a, op)` by `formula`; no point
+    /// at its observer. `libm_trig` takes libm's `sin_cos`, point by point,
+    /// for surfaces where some `k·r` exceeds [`crate::sincos::MAX_ARGUMENT`].
+    pub(crate) fn evaluate(&mut self, kernels: &CoupledKernels, formula: Formula, libm_trig: bool) {
+        self.evaluate_by(kernels, formula, if libm_trig { Trig::Libm } else { Trig::Polynomial });
+    }
+
+    /// [`SourcePoints::evaluate`] with `trig`.
+    fn evaluate_by(&mut self, kernels: &CoupledKernels, formula: Formula, trig: Trig) {
         let n = self.len();
         for v in self.a.iter_mut().chain(&mut self.op) {
-            v.clear();
-            v.resize(n, 0.0);
+            if v.len() < n {
+                v.resize(n, 0.0);
+            }
         }
-        let coefficients = Coefficients::new(kernels);
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: evaluate_avx2's one requirement, AVX2, was just detected.
-            unsafe { evaluate_avx2(&coefficients, x, nx, self) };
-            return;
+        let c = Coefficients::new(kernels);
+        let columns = self.columns.get_or_insert_with(Box::default);
+        for (start, chunk) in (0..n).step_by(CHUNK).zip(self.points.chunks(CHUNK)) {
+            columns.fill(chunk);
+            let columns = &**columns;
+            let end = start + chunk.len();
+            let ([a_re, a_im], [op_re, op_im]) = (&mut self.a, &mut self.op);
+            let out = Outputs {
+                a: [&mut a_re[start..end], &mut a_im[start..end]],
+                op: [&mut op_re[start..end], &mut op_im[start..end]],
+            };
+            match (formula, trig) {
+                (Formula::Coupled, Trig::Libm) => evaluate_lanes::<false, true>(&c, columns, out),
+                (Formula::Remainder, Trig::Libm) => evaluate_lanes::<true, true>(&c, columns, out),
+                (Formula::Coupled, Trig::Polynomial) => evaluate_polynomial::<false>(&c, columns, out),
+                (Formula::Remainder, Trig::Polynomial) => evaluate_polynomial::<true>(&c, columns, out),
+                #[cfg(test)]
+                (Formula::Coupled, Trig::PolynomialPortable) => {
+                    evaluate_lanes::<false, false>(&c, columns, out)
+                }
+                #[cfg(test)]
+                (Formula::Remainder, Trig::PolynomialPortable) => {
+                    evaluate_lanes::<true, false>(&c, columns, out)
+                }
+            }
         }
-        evaluate_lanes(&coefficients, x, nx, self);
     }
+}
+
+/// The `sin_cos` of an evaluation and how it is compiled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Trig {
+    /// libm's, point by point (any argument).
+    Libm,
+    /// [`crate::sincos`], four lanes where the CPU has AVX2.
+    Polynomial,
+    /// [`crate::sincos`], two lanes (any x86-64): the tests' reference.
+    #[cfg(test)]
+    PolynomialPortable,
+}
+
+/// A chunk of points as columns (structure of arrays), `len` of them.
+struct Columns {
+    x: [[f64; CHUNK]; 3],
+    nx: [[f64; CHUNK]; 3],
+    y: [[f64; CHUNK]; 3],
+    n: [[f64; CHUNK]; 3],
+    w: [f64; CHUNK],
+    len: usize,
+}
+
+impl Default for Columns {
+    fn default() -> Self {
+        let zero = [[0.0; CHUNK]; 3];
+        Columns { x: zero, nx: zero, y: zero, n: zero, w: [0.0; CHUNK], len: 0 }
+    }
+}
+
+impl Columns {
+    fn fill(&mut self, chunk: &[SourcePoint]) {
+        debug_assert!(chunk.len() <= CHUNK);
+        self.len = chunk.len();
+        for (i, p) in chunk.iter().enumerate() {
+            for k in 0..3 {
+                self.x[k][i] = p.x[k];
+                self.nx[k][i] = p.nx[k];
+                self.y[k][i] = p.y[k];
+                self.n[k][i] = p.n[k];
+            }
+            self.w[i] = p.w;
+        }
+    }
+}
+
+/// Where a chunk's `(a, op)` go, as real and imaginary parts.
+struct Outputs<'a> {
+    a: [&'a mut [f64]; 2],
+    op: [&'a mut [f64]; 2],
 }
 
 /// The kernels' scalars: `k`, `α` and `iα` as real and imaginary parts.
@@ -108,88 +219,209 @@ impl Coefficients {
     }
 }
 
-/// [`evaluate_lanes`] compiled for AVX2 (four f64 lanes).
+/// [`evaluate_lanes`] with the vectorizable `sin_cos`, compiled for AVX2
+/// (four f64 lanes) when the CPU has it.
+fn evaluate_polynomial<const REMAINDER: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: evaluate_avx2's one requirement, AVX2, was just detected.
+        unsafe { evaluate_avx2::<REMAINDER>(c, cols, out) };
+        return;
+    }
+    evaluate_lanes::<REMAINDER, false>(c, cols, out);
+}
+
+/// [`evaluate_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn evaluate_avx2(c: &Coefficients, x: [f64; 3], nx: [f64; 3], pts: &mut SourcePoints) {
-    evaluate_lanes(c, x, nx, pts);
+fn evaluate_avx2<const REMAINDER: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
+    evaluate_lanes::<REMAINDER, false>(c, cols, out);
 }
 
 /// The loop the compiler vectorizes (module doc): every slice cut to the
-/// same length so that no bounds check is left inside.
+/// same length so that no bounds check is left inside; the formula and
+/// the `sin_cos` are chosen at compile time.
 #[inline(always)]
-fn evaluate_lanes(c: &Coefficients, x: [f64; 3], nx: [f64; 3], pts: &mut SourcePoints) {
-    let n = pts.w.len();
-    let (y0, y1, y2) = (&pts.y[0][..n], &pts.y[1][..n], &pts.y[2][..n]);
-    let (n0, n1, n2) = (&pts.n[0][..n], &pts.n[1][..n], &pts.n[2][..n]);
-    let w = &pts.w[..n];
-    let [a_re, a_im] = &mut pts.a;
-    let [op_re, op_im] = &mut pts.op;
+fn evaluate_lanes<const REMAINDER: bool, const LIBM: bool>(
+    c: &Coefficients,
+    cols: &Columns,
+    out: Outputs<'_>,
+) {
+    let n = cols.len;
+    let (x0, x1, x2) = (&cols.x[0][..n], &cols.x[1][..n], &cols.x[2][..n]);
+    let (m0, m1, m2) = (&cols.nx[0][..n], &cols.nx[1][..n], &cols.nx[2][..n]);
+    let (y0, y1, y2) = (&cols.y[0][..n], &cols.y[1][..n], &cols.y[2][..n]);
+    let (n0, n1, n2) = (&cols.n[0][..n], &cols.n[1][..n], &cols.n[2][..n]);
+    let w = &cols.w[..n];
+    let Outputs { a: [a_re, a_im], op: [op_re, op_im] } = out;
     let (a_re, a_im, op_re, op_im) = (&mut a_re[..n], &mut a_im[..n], &mut op_re[..n], &mut op_im[..n]);
-    let (k, [al_re, al_im], [ia_re, ia_im]) = (c.k, c.alpha, c.i_alpha);
     for i in 0..n {
-        let d = [y0[i] - x[0], y1[i] - x[1], y2[i] - x[2]];
+        let d = [y0[i] - x0[i], y1[i] - x1[i], y2[i] - x2[i]];
         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let r = r2.sqrt();
-        let kr = k * r;
-        let (sn, cs) = sin_cos(kr);
-        let scale = w[i] / (FOUR_PI * r);
-        let (gw_re, gw_im) = (cs * scale, sn * scale);
-        let u = 1.0 / r2;
-        let dny = d[0] * n0[i] + d[1] * n1[i] + d[2] * n2[i];
-        let dnx = d[0] * nx[0] + d[1] * nx[1] + d[2] * nx[2];
-        let nxny = nx[0] * n0[i] + nx[1] * n1[i] + nx[2] * n2[i];
-        // αt = iα·kr − α, αs = α(3 − k²r²) − iα·3kr.
-        let (at_re, at_im) = (ia_re * kr - al_re, ia_im * kr - al_im);
+        let kr = c.k * r;
+        let (sn, cs) = if LIBM { kr.sin_cos() } else { sin_cos(kr) };
+        let point = Point {
+            kr,
+            e: [cs, sn],
+            scale: w[i] / (FOUR_PI * r),
+            u: 1.0 / r2,
+            dny: d[0] * n0[i] + d[1] * n1[i] + d[2] * n2[i],
+            dnx: d[0] * m0[i] + d[1] * m1[i] + d[2] * m2[i],
+            nxny: m0[i] * n0[i] + m1[i] * n1[i] + m2[i] * n2[i],
+        };
+        let (a, op) = if REMAINDER { point.remainder(c) } else { point.coupled(c) };
+        (a_re[i], a_im[i], op_re[i], op_im[i]) = (a[0], a[1], op[0], op[1]);
+    }
+}
+
+/// One source point's geometry seen from its observer: `k·r`, `e^{ikr}`,
+/// `w/(4πr)`, `1/r²`, `d·n_y`, `d·n_x`, `n_x·n_y`.
+struct Point {
+    kr: f64,
+    e: [f64; 2],
+    scale: f64,
+    u: f64,
+    dny: f64,
+    dnx: f64,
+    nxny: f64,
+}
+
+/// `(a·b)` of complex numbers as `[re, im]`.
+#[inline(always)]
+fn mul(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]]
+}
+
+impl Point {
+    /// `(a, op)` of the coupled kernels (module doc).
+    #[inline(always)]
+    fn coupled(&self, c: &Coefficients) -> ([f64; 2], [f64; 2]) {
+        let Point { kr, e, scale, u, dny, dnx, nxny } = *self;
+        let (al, ia) = (c.alpha, c.i_alpha);
+        let gw = [e[0] * scale, e[1] * scale];
+        let alpha_t = [ia[0] * kr - al[0], ia[1] * kr - al[1]];
         let (f, g) = (3.0 - kr * kr, 3.0 * kr);
-        let (as_re, as_im) = (al_re * f - ia_re * g, al_im * f - ia_im * g);
-        // bracket = (−1 + i·kr)(d·n_y) − αt (n_x·n_y) − αs (d·n_x)(d·n_y) u.
+        let alpha_s = [al[0] * f - ia[0] * g, al[1] * f - ia[1] * g];
         let c3 = dnx * dny * u;
-        let br_re = -dny - at_re * nxny - as_re * c3;
-        let br_im = kr * dny - at_im * nxny - as_im * c3;
-        let (gu_re, gu_im) = (gw_re * u, gw_im * u);
-        a_re[i] = -(gu_re * br_re - gu_im * br_im);
-        a_im[i] = -(gu_re * br_im + gu_im * br_re);
-        // op = −G w (1 − αt (d·n_x) u).
-        let e = dnx * u;
-        let (m_re, m_im) = (1.0 - at_re * e, -at_im * e);
-        op_re[i] = -(gw_re * m_re - gw_im * m_im);
-        op_im[i] = -(gw_re * m_im + gw_im * m_re);
+        let bracket =
+            [-dny - alpha_t[0] * nxny - alpha_s[0] * c3, kr * dny - alpha_t[1] * nxny - alpha_s[1] * c3];
+        let a = mul([gw[0] * u, gw[1] * u], bracket);
+        let e_nx = dnx * u;
+        let op = mul(gw, [1.0 - alpha_t[0] * e_nx, -alpha_t[1] * e_nx]);
+        ([-a[0], -a[1]], [-op[0], -op[1]])
+    }
+
+    /// `(a, op)` of the remainder kernels (module doc).
+    #[inline(always)]
+    fn remainder(&self, c: &Coefficients) -> ([f64; 2], [f64; 2]) {
+        let Point { kr, e, scale, u, dny, dnx, nxny } = *self;
+        let al = c.alpha;
+        let h = 0.5 * kr * kr;
+        let su = scale * u;
+        // R₁ = [e(ikr − 1) + 1 + h]/(4πr³), times w.
+        let t = mul(e, [-1.0, kr]);
+        let r1 = [(t[0] + 1.0 + h) * su, t[1] * su];
+        let g = [(e[0] - 1.0) * scale, e[1] * scale];
+        let dg_dny = [r1[0] * dny, r1[1] * dny];
+        let dg_dnx = [-r1[0] * dnx, -r1[1] * dnx];
+        let p = mul(e, [1.0, -kr]);
+        let q = mul(e, [3.0 - kr * kr, -3.0 * kr]);
+        let cdd = dnx * dny * u;
+        let d2g = [((p[0] - 1.0 - h) * nxny - (q[0] - 3.0 - h) * cdd) * su, (p[1] * nxny - q[1] * cdd) * su];
+        let al_d2g = mul(al, d2g);
+        let al_dnx = mul(al, dg_dnx);
+        ([-dg_dny[0] - al_d2g[0], -dg_dny[1] - al_d2g[1]], [-g[0] - al_dnx[0], -g[1] - al_dnx[1]])
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::BoundaryMesh;
+    use crate::kernels::Kernels;
 
-    #[test]
-    fn batched_weights_equal_the_point_kernel_in_every_lane_width() {
-        // Points around x at distances 1 mm – 1 m, with k·r up to ≈ 400.
-        let alpha = c64::new(0.0, 1.0 / 300.0);
-        let kernels = CoupledKernels::new(300.0, alpha);
-        let (x, nx) = ([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]);
+    /// A point and its normal.
+    type Observer = ([f64; 3], [f64; 3]);
+    /// A source point, its normal and weight.
+    type Source = ([f64; 3], [f64; 3], f64);
+
+    /// Points around `x` at distances 1 mm – 1 m (k·r up to ≈ 400), each
+    /// gathered twice, seen from `x` and from a second observer.
+    fn gathered(observers: [Observer; 2]) -> (SourcePoints, Vec<Source>) {
         let mut pts = SourcePoints::default();
-        let mut want = Vec::new();
+        let mut sources = Vec::new();
         for i in 0..37 {
             let t = i as f64;
             let r = 0.001 * 1.2f64.powf(t);
+            let x = observers[0].0;
             let y = [x[0] + r * (0.7 * t).cos(), x[1] + r * (0.7 * t).sin(), x[2] + 0.3 * r];
             let ny = [(0.3 * t).sin(), (0.3 * t).cos(), 0.0];
             let w = 1e-6 * (1.0 + t);
-            pts.push(y, ny, w, i % 5, i);
-            want.push(kernels.point(x, nx, y, ny, w));
+            for (o, observer) in observers.iter().enumerate() {
+                pts.push(*observer, y, ny, w, i % 5 + o, i);
+            }
+            sources.push((y, ny, w));
         }
-        pts.evaluate(&kernels, x, nx);
+        (pts, sources)
+    }
+
+    fn close(got: c64, want: c64, what: &str) {
+        assert!((got - want).norm() <= 1e-13 * want.norm(), "{what}: {got} vs {want}");
+    }
+
+    #[test]
+    fn coupled_weights_equal_the_point_kernel_in_every_lane_width() {
+        let kernels = CoupledKernels::new(300.0, c64::new(0.0, 1.0 / 300.0));
+        let observers = [([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]), ([0.2, 0.1, -0.1], [1.0, 0.0, 0.0])];
+        let (mut pts, sources) = gathered(observers);
+        pts.evaluate(&kernels, Formula::Coupled, false);
         let wide = (0..pts.len()).map(|p| pts.weights(p)).collect::<Vec<_>>();
         // The portable loop (two lanes) gives the same bits as the run-time choice.
-        let c = Coefficients::new(&kernels);
-        evaluate_lanes(&c, x, nx, &mut pts);
+        pts.evaluate_by(&kernels, Formula::Coupled, Trig::PolynomialPortable);
         for (p, (a, op)) in wide.iter().enumerate() {
             assert_eq!((*a, *op), pts.weights(p), "point {p}");
-            let (a0, op0) = want[p];
-            assert!((a - a0).norm() <= 1e-13 * a0.norm(), "a at point {p}: {a} vs {a0}");
-            assert!((op - op0).norm() <= 1e-13 * op0.norm(), "op at point {p}: {op} vs {op0}");
+            let (x, nx) = observers[p % 2];
+            let (y, ny, w) = sources[p / 2];
+            let (a0, op0) = kernels.point(x, nx, y, ny, w);
+            close(*a, a0, &format!("a at point {p}"));
+            close(*op, op0, &format!("op at point {p}"));
         }
-        assert_eq!(pts.owner[36], (1, 36));
+        assert_eq!(pts.owners().nth(73), Some((2, 36)));
+        // libm's sin_cos (surfaces beyond the polynomial's range) agrees too.
+        pts.evaluate(&kernels, Formula::Coupled, true);
+        for (p, (a, op)) in wide.iter().enumerate() {
+            let (a1, op1) = pts.weights(p);
+            close(a1, *a, &format!("libm a at point {p}"));
+            close(op1, *op, &format!("libm op at point {p}"));
+        }
+    }
+
+    #[test]
+    fn remainder_weights_equal_the_remainder_integrals() {
+        // One panel's 7-point remainder (k·h ≤ 2: not split) seen from points
+        // off it, against Kernels::remainder combined as the assembly does.
+        let (k, alpha) = (380.0, c64::new(0.0, 1.0 / 380.0));
+        let t = [[0.0, 0.0, 0.0], [0.004, 0.0, 0.0], [0.0, 0.003, 0.0005]];
+        let mesh = BoundaryMesh::new(t.to_vec(), &[[0, 1, 2]]).expect("one panel");
+        let panel = &mesh.panels[0];
+        assert!(k * panel.diameter <= crate::kernels::REMAINDER_MAX_KH, "the rule must not split");
+        let kernels = CoupledKernels::new(k, alpha);
+        for (x, nx) in [([0.001, 0.001, 0.004], [0.0, 0.0, 1.0]), ([0.01, -0.003, 0.002], [0.6, 0.0, 0.8])] {
+            let mut pts = SourcePoints::default();
+            for (b, w) in crate::quadrature::TRIANGLE_7 {
+                pts.push((x, nx), crate::quadrature::on_triangle(b, t), panel.normal, w * panel.area, 0, 0);
+            }
+            pts.evaluate(&kernels, Formula::Remainder, false);
+            let (mut a, mut op) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
+            for p in 0..pts.len() {
+                let (da, dop) = pts.weights(p);
+                a += da;
+                op += dop;
+            }
+            let ints = Kernels::new(k).remainder(&mesh, panel, x, nx);
+            close(a, -ints.dg_dny - alpha * ints.d2g, "a");
+            close(op, -(ints.g + alpha * ints.dg_dnx), "op");
+        }
     }
 }

@@ -381,26 +381,6 @@ impl CoupledKernels {
         let bracket = t * dny - alpha_t * dot(nx, ny) - alpha_s * (dnx * dny * u);
         (-(gw * u) * bracket, -gw * (c64::new(1.0, 0.0) - alpha_t * (dnx * u)))
     }
-
-    /// `(a, op)` of a panel (normal `ny`, area `area`) by the 3-point rule
-    /// at its quadrature points `points` ([`crate::quadrature::TRIANGLE_3`]).
-    #[inline]
-    pub fn three_point(
-        &self,
-        x: [f64; 3],
-        nx: [f64; 3],
-        points: &[[f64; 3]; 3],
-        ny: [f64; 3],
-        area: f64,
-    ) -> (c64, c64) {
-        let mut sum = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
-        for (y, (_, w)) in points.iter().zip(crate::quadrature::TRIANGLE_3) {
-            let (a, op) = self.point(x, nx, *y, ny, w * area);
-            sum.0 += a;
-            sum.1 += op;
-        }
-        sum
-    }
 }
 
 /// The `k`-independent coefficients of the four panel integrals (module
