@@ -35,8 +35,8 @@ use rayon::prelude::*;
 
 use crate::batch::{Formula, SourcePoints};
 use crate::cluster::Clusters;
-use crate::geometry::{norm, sub, BoundaryMesh, Panel};
-use crate::kernels::{CoupledKernels, Kernels, PointKernel, REMAINDER_MAX_KH};
+use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
+use crate::kernels::{CoupledKernels, Kernels, REMAINDER_MAX_KH};
 use crate::near::NearField;
 use crate::quadrature::{on_triangle, TRIANGLE_3, TRIANGLE_7};
 
@@ -267,11 +267,12 @@ impl<'a> Assembly<'a> {
     /// near-remainder rules are gathered into `g` and evaluated in SIMD
     /// lanes ([`crate::batch`]) after the rest of the row.
     fn row_gathered(&self, i: usize, sources: &[usize], row: &mut [c64], b: &mut [c64], g: &mut Gathered) {
-        let (k, alpha) = (self.kern.k(), self.alpha);
+        let k = self.kern.k();
         let region = &self.regions[i];
         let nrhs = self.q.len().max(1);
         g.coupled.clear();
         g.remainder.clear();
+        g.far.clear();
         for (slot_index, ((slot, &c), b)) in row.iter_mut().zip(sources).zip(b.chunks_mut(nrhs)).enumerate() {
             *slot = c64::new(0.0, 0.0);
             b.fill(c64::new(0.0, 0.0));
@@ -284,13 +285,7 @@ impl<'a> Assembly<'a> {
                 && clear >= CLUSTER_NEAR_RATIO * (region.radius + src.max_diameter)
                 && clear >= region.radius + MID_POINT_RATIO * src.max_diameter;
             if far_cluster {
-                let pk = PointKernel::new(k, region.centre, region.normal, src.centre);
-                *slot -= pk.dg_dny(src.normal_sum) + alpha * pk.d2g(src.normal_sum);
-                let f_mono = pk.g + alpha * pk.dg_dnx;
-                for (bf, m) in b.iter_mut().zip(&self.moments[c]) {
-                    let dipole = |d: [f64; 3]| pk.dg_dny(d) + alpha * pk.d2g(d);
-                    *bf -= f_mono * m.q + dipole(m.d_re) + c64::new(0.0, 1.0) * dipole(m.d_im);
-                }
+                g.far.push((region.centre, region.normal), src.centre, [0.0; 3], 1.0, slot_index, c);
                 continue;
             }
             for panel in &self.sources[src.span.clone()] {
@@ -303,6 +298,30 @@ impl<'a> Assembly<'a> {
         }
         self.add_gathered(&mut g.coupled, Formula::Coupled, row, b);
         self.add_gathered(&mut g.remainder, Formula::Remainder, row, b);
+        self.add_far_clusters(i, &mut g.far, row, b);
+    }
+
+    /// Evaluates the far source clusters gathered in `pts` (one point at
+    /// each centroid, owner = its cluster) and adds each as the module doc
+    /// says: the matrix entry `a(Σ A_j n_j)`, the right-hand sides
+    /// `op·Q + a(D)` (`a` linear in the normal, [`Formula::Linear`]).
+    fn add_far_clusters(&self, i: usize, pts: &mut SourcePoints, row: &mut [c64], b: &mut [c64]) {
+        if pts.len() == 0 {
+            return;
+        }
+        let region = &self.regions[i];
+        let nrhs = self.q.len().max(1);
+        pts.evaluate(&self.coupled, Formula::Linear, !self.lanes);
+        for (p, (slot, c)) in pts.owners().enumerate() {
+            let (dn, nn, op) = pts.linear_weights(p);
+            let src = &self.regions[c];
+            let d = sub(src.centre, region.centre);
+            let a = |n: [f64; 3]| dn * dot(d, n) + nn * dot(region.normal, n);
+            row[slot] += a(src.normal_sum);
+            for (bf, m) in b[slot * nrhs..(slot + 1) * nrhs].iter_mut().zip(&self.moments[c]) {
+                *bf += op * m.q + a(m.d_re) + c64::new(0.0, 1.0) * a(m.d_im);
+            }
+        }
     }
 
     /// Evaluates the gathered points `pts` by `formula` and adds each to
@@ -341,16 +360,21 @@ impl<'a> Assembly<'a> {
             let pt = &mesh.panels[t];
             let seen_from = (pt.centroid, pt.normal);
             let (panels, statics) = self.near_field.row(t);
+            // The near field holds exactly the panels with |c_j − c_t| < 3 h_j
+            // (crate::near): only those can be found in t's row.
+            let d = sub(src.centroid, pt.centroid);
+            let reach = MID_POINT_RATIO * src.diameter;
+            let in_reach = t != j && dot(d, d) < reach * reach;
+            let near_index = if in_reach { panels.binary_search(&(j as u32)).ok() } else { None };
             let (ints, half) = if t == j {
                 (kern.self_integrals(mesh, pj), 0.5)
-            } else if let Ok(s) = panels.binary_search(&(j as u32)) {
+            } else if let Some(s) = near_index {
                 let (da, dop) = self.near_remainder(src, seen_from, w, slot, g);
                 a += da;
                 op += dop;
                 (statics[s].at(kern.k()), 0.0)
             } else {
-                let (da, dop) =
-                    self.off_panel(src, seen_from, norm(sub(src.centroid, pt.centroid)), w, slot, g);
+                let (da, dop) = self.off_panel(src, seen_from, norm(d), w, slot, g);
                 a += da;
                 op += dop;
                 continue;
@@ -451,11 +475,13 @@ fn is_near(region: &Region, src: &SourcePanel, dist: f64) -> bool {
 }
 
 /// A row's gathered source points ([`crate::batch`]): of the coupled
-/// kernels (centroid and 3-point rules) and of the near remainders.
+/// kernels (centroid and 3-point rules), of the near remainders, and the
+/// far clusters' centroids.
 #[derive(Default)]
 struct Gathered {
     coupled: SourcePoints,
     remainder: SourcePoints,
+    far: SourcePoints,
 }
 
 thread_local! {

@@ -41,7 +41,17 @@ pub(crate) enum Formula {
     Coupled,
     /// The near pairs' remainder.
     Remainder,
+    /// The coupled kernels' coefficients for a source normal given later:
+    /// `a(n_y) = P (d·n_y) + Q (n_x·n_y)` (`a` is linear in `n_y`), with
+    /// `P = −G w u (t − αs (d·n_x) u)`, `Q = G w u αt`, and `op`. The far
+    /// cluster sums of [`crate::assembly`] apply it to a summed normal and
+    /// to dipole moments.
+    Linear,
 }
+
+const COUPLED: u8 = 0;
+const REMAINDER: u8 = 1;
+const LINEAR: u8 = 2;
 
 /// Source points gathered for one row: the point and normal each is seen
 /// from, its position, normal and weight, the row slot and panel it
@@ -51,9 +61,11 @@ pub(crate) struct SourcePoints {
     points: Vec<SourcePoint>,
     /// Where each chunk is moved into columns, kept from call to call.
     columns: Option<Box<Columns>>,
-    /// `a` and `op` of the points (real, imaginary), first `len()` valid.
+    /// `a` (or `P`), `op` and `Q` of the points (real, imaginary), first
+    /// `len()` valid (`Q` by [`Formula::Linear`] alone).
     a: [Vec<f64>; 2],
     op: [Vec<f64>; 2],
+    q: [Vec<f64>; 2],
 }
 
 /// One gathered point, stored as it comes (one push per point); the
@@ -84,8 +96,8 @@ impl SourcePoints {
     }
 
     /// Adds a source point `y` (normal `n`, quadrature weight `w`) of panel
-    /// `panel` seen from `x` (normal `nx`), to be summed into row entry
-    /// `slot`.
+    /// `panel` (or the cluster it stands for) seen from `x` (normal `nx`),
+    /// to be summed into row entry `slot`.
     #[inline]
     pub(crate) fn push(
         &mut self,
@@ -99,7 +111,8 @@ impl SourcePoints {
         self.points.push(SourcePoint { x, nx, y, n, w, slot: slot as u32, panel: panel as u32 });
     }
 
-    /// The row entry and mesh panel of each gathered point, in order.
+    /// The row entry and mesh panel (or cluster) of each gathered point, in
+    /// order.
     pub(crate) fn owners(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.points.iter().map(|p| (p.slot as usize, p.panel as usize))
     }
@@ -108,6 +121,14 @@ impl SourcePoints {
     #[inline]
     pub(crate) fn weights(&self, p: usize) -> (c64, c64) {
         (c64::new(self.a[0][p], self.a[1][p]), c64::new(self.op[0][p], self.op[1][p]))
+    }
+
+    /// `(P, Q, op)` of gathered point `p` (after [`SourcePoints::evaluate`]
+    /// by [`Formula::Linear`]).
+    #[inline]
+    pub(crate) fn linear_weights(&self, p: usize) -> (c64, c64, c64) {
+        let (a, op) = self.weights(p);
+        (a, c64::new(self.q[0][p], self.q[1][p]), op)
     }
 
     /// Evaluates every gathered point's `(a, op)` by `formula`; no point
@@ -120,7 +141,7 @@ impl SourcePoints {
     /// [`SourcePoints::evaluate`] with `trig`.
     fn evaluate_by(&mut self, kernels: &CoupledKernels, formula: Formula, trig: Trig) {
         let n = self.len();
-        for v in self.a.iter_mut().chain(&mut self.op) {
+        for v in self.a.iter_mut().chain(&mut self.op).chain(&mut self.q) {
             if v.len() < n {
                 v.resize(n, 0.0);
             }
@@ -131,26 +152,28 @@ impl SourcePoints {
             columns.fill(chunk);
             let columns = &**columns;
             let end = start + chunk.len();
-            let ([a_re, a_im], [op_re, op_im]) = (&mut self.a, &mut self.op);
+            let ([a_re, a_im], [op_re, op_im], [q_re, q_im]) = (&mut self.a, &mut self.op, &mut self.q);
             let out = Outputs {
                 a: [&mut a_re[start..end], &mut a_im[start..end]],
                 op: [&mut op_re[start..end], &mut op_im[start..end]],
+                q: [&mut q_re[start..end], &mut q_im[start..end]],
             };
-            match (formula, trig) {
-                (Formula::Coupled, Trig::Libm) => evaluate_lanes::<false, true>(&c, columns, out),
-                (Formula::Remainder, Trig::Libm) => evaluate_lanes::<true, true>(&c, columns, out),
-                (Formula::Coupled, Trig::Polynomial) => evaluate_polynomial::<false>(&c, columns, out),
-                (Formula::Remainder, Trig::Polynomial) => evaluate_polynomial::<true>(&c, columns, out),
-                #[cfg(test)]
-                (Formula::Coupled, Trig::PolynomialPortable) => {
-                    evaluate_lanes::<false, false>(&c, columns, out)
-                }
-                #[cfg(test)]
-                (Formula::Remainder, Trig::PolynomialPortable) => {
-                    evaluate_lanes::<true, false>(&c, columns, out)
-                }
+            match formula {
+                Formula::Coupled => evaluate_with::<COUPLED>(&c, columns, out, trig),
+                Formula::Remainder => evaluate_with::<REMAINDER>(&c, columns, out, trig),
+                Formula::Linear => evaluate_with::<LINEAR>(&c, columns, out, trig),
             }
         }
+    }
+}
+
+/// [`evaluate_lanes`] of formula `F` with `trig`.
+fn evaluate_with<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>, trig: Trig) {
+    match trig {
+        Trig::Libm => evaluate_lanes::<F, true>(c, cols, out),
+        Trig::Polynomial => evaluate_polynomial::<F>(c, cols, out),
+        #[cfg(test)]
+        Trig::PolynomialPortable => evaluate_lanes::<F, false>(c, cols, out),
     }
 }
 
@@ -199,10 +222,11 @@ impl Columns {
     }
 }
 
-/// Where a chunk's `(a, op)` go, as real and imaginary parts.
+/// Where a chunk's `(a, op)` (and `Q`) go, as real and imaginary parts.
 struct Outputs<'a> {
     a: [&'a mut [f64]; 2],
     op: [&'a mut [f64]; 2],
+    q: [&'a mut [f64]; 2],
 }
 
 /// The kernels' scalars: `k`, `α` and `iα` as real and imaginary parts.
@@ -221,40 +245,37 @@ impl Coefficients {
 
 /// [`evaluate_lanes`] with the vectorizable `sin_cos`, compiled for AVX2
 /// (four f64 lanes) when the CPU has it.
-fn evaluate_polynomial<const REMAINDER: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
+fn evaluate_polynomial<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: evaluate_avx2's one requirement, AVX2, was just detected.
-        unsafe { evaluate_avx2::<REMAINDER>(c, cols, out) };
+        unsafe { evaluate_avx2::<F>(c, cols, out) };
         return;
     }
-    evaluate_lanes::<REMAINDER, false>(c, cols, out);
+    evaluate_lanes::<F, false>(c, cols, out);
 }
 
 /// [`evaluate_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn evaluate_avx2<const REMAINDER: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
-    evaluate_lanes::<REMAINDER, false>(c, cols, out);
+fn evaluate_avx2<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
+    evaluate_lanes::<F, false>(c, cols, out);
 }
 
 /// The loop the compiler vectorizes (module doc): every slice cut to the
 /// same length so that no bounds check is left inside; the formula and
 /// the `sin_cos` are chosen at compile time.
 #[inline(always)]
-fn evaluate_lanes<const REMAINDER: bool, const LIBM: bool>(
-    c: &Coefficients,
-    cols: &Columns,
-    out: Outputs<'_>,
-) {
+fn evaluate_lanes<const F: u8, const LIBM: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
     let n = cols.len;
     let (x0, x1, x2) = (&cols.x[0][..n], &cols.x[1][..n], &cols.x[2][..n]);
     let (m0, m1, m2) = (&cols.nx[0][..n], &cols.nx[1][..n], &cols.nx[2][..n]);
     let (y0, y1, y2) = (&cols.y[0][..n], &cols.y[1][..n], &cols.y[2][..n]);
     let (n0, n1, n2) = (&cols.n[0][..n], &cols.n[1][..n], &cols.n[2][..n]);
     let w = &cols.w[..n];
-    let Outputs { a: [a_re, a_im], op: [op_re, op_im] } = out;
+    let Outputs { a: [a_re, a_im], op: [op_re, op_im], q: [q_re, q_im] } = out;
     let (a_re, a_im, op_re, op_im) = (&mut a_re[..n], &mut a_im[..n], &mut op_re[..n], &mut op_im[..n]);
+    let (q_re, q_im) = (&mut q_re[..n], &mut q_im[..n]);
     for i in 0..n {
         let d = [y0[i] - x0[i], y1[i] - x1[i], y2[i] - x2[i]];
         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
@@ -270,7 +291,15 @@ fn evaluate_lanes<const REMAINDER: bool, const LIBM: bool>(
             dnx: d[0] * m0[i] + d[1] * m1[i] + d[2] * m2[i],
             nxny: m0[i] * n0[i] + m1[i] * n1[i] + m2[i] * n2[i],
         };
-        let (a, op) = if REMAINDER { point.remainder(c) } else { point.coupled(c) };
+        let (a, op) = match F {
+            REMAINDER => point.remainder(c),
+            LINEAR => {
+                let (p, q, op) = point.linear(c);
+                (q_re[i], q_im[i]) = (q[0], q[1]);
+                (p, op)
+            }
+            _ => point.coupled(c),
+        };
         (a_re[i], a_im[i], op_re[i], op_im[i]) = (a[0], a[1], op[0], op[1]);
     }
 }
@@ -310,6 +339,22 @@ impl Point {
         let e_nx = dnx * u;
         let op = mul(gw, [1.0 - alpha_t[0] * e_nx, -alpha_t[1] * e_nx]);
         ([-a[0], -a[1]], [-op[0], -op[1]])
+    }
+
+    /// `(P, Q, op)` of [`Formula::Linear`].
+    #[inline(always)]
+    fn linear(&self, c: &Coefficients) -> ([f64; 2], [f64; 2], [f64; 2]) {
+        let Point { kr, e, scale, u, dnx, .. } = *self;
+        let (al, ia) = (c.alpha, c.i_alpha);
+        let gwu = [e[0] * scale * u, e[1] * scale * u];
+        let alpha_t = [ia[0] * kr - al[0], ia[1] * kr - al[1]];
+        let (f, g) = (3.0 - kr * kr, 3.0 * kr);
+        let alpha_s = [al[0] * f - ia[0] * g, al[1] * f - ia[1] * g];
+        let e_nx = dnx * u;
+        let p = mul(gwu, [-1.0 - alpha_s[0] * e_nx, kr - alpha_s[1] * e_nx]);
+        let q = mul(gwu, alpha_t);
+        let op = mul([e[0] * scale, e[1] * scale], [1.0 - alpha_t[0] * e_nx, -alpha_t[1] * e_nx]);
+        ([-p[0], -p[1]], q, [-op[0], -op[1]])
     }
 
     /// `(a, op)` of the remainder kernels (module doc).
@@ -394,6 +439,28 @@ mod tests {
             let (a1, op1) = pts.weights(p);
             close(a1, *a, &format!("libm a at point {p}"));
             close(op1, *op, &format!("libm op at point {p}"));
+        }
+    }
+
+    #[test]
+    fn linear_coefficients_give_the_point_kernel_for_any_normal() {
+        let (k, alpha) = (250.0, c64::new(0.0, 1.0 / 250.0));
+        let kernels = CoupledKernels::new(k, alpha);
+        let observers = [([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]), ([0.2, 0.1, -0.1], [1.0, 0.0, 0.0])];
+        let (mut pts, sources) = gathered(observers);
+        pts.evaluate(&kernels, Formula::Linear, false);
+        for p in 0..pts.len() {
+            let (x, nx) = observers[p % 2];
+            let (y, ny, w) = sources[p / 2];
+            let (dn, nn, op) = pts.linear_weights(p);
+            let pk = crate::kernels::PointKernel::new(k, x, nx, y);
+            let d = crate::geometry::sub(y, x);
+            // A summed normal and a dipole moment are not unit vectors.
+            for n in [ny, [0.3, -2.0, 0.7]] {
+                let a = (dn * crate::geometry::dot(d, n) + nn * crate::geometry::dot(nx, n)) / w;
+                close(a, -(pk.dg_dny(n) + alpha * pk.d2g(n)), &format!("a at point {p}"));
+            }
+            close(op / w, -(pk.g + alpha * pk.dg_dnx), &format!("op at point {p}"));
         }
     }
 
