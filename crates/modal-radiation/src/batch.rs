@@ -58,9 +58,12 @@ const LINEAR: u8 = 2;
 /// belongs to, and after [`SourcePoints::evaluate`] its weights `a`, `op`.
 #[derive(Default)]
 pub(crate) struct SourcePoints {
-    points: Vec<SourcePoint>,
-    /// Where each chunk is moved into columns, kept from call to call.
-    columns: Option<Box<Columns>>,
+    /// The points as columns, [`CHUNK`] to a block; blocks are kept when
+    /// cleared, so a thread allocates them once.
+    chunks: Vec<Box<Columns>>,
+    len: usize,
+    /// Row entry and panel (or cluster) of each point.
+    owner: Vec<(u32, u32)>,
     /// `a` (or `P`), `op` and `Q` of the points (real, imaginary), first
     /// `len()` valid (`Q` by [`Formula::Linear`] alone).
     a: [Vec<f64>; 2],
@@ -68,31 +71,19 @@ pub(crate) struct SourcePoints {
     q: [Vec<f64>; 2],
 }
 
-/// One gathered point, stored as it comes (one push per point); the
-/// evaluation moves chunks of them into columns.
-#[derive(Clone, Copy)]
-struct SourcePoint {
-    x: [f64; 3],
-    nx: [f64; 3],
-    y: [f64; 3],
-    n: [f64; 3],
-    w: f64,
-    slot: u32,
-    panel: u32,
-}
-
-/// Points moved into columns at a time: a chunk's columns stay in L1.
+/// Points per block of columns: a block's columns stay in L1.
 const CHUNK: usize = 64;
 
 impl SourcePoints {
     /// Empties the gathered points, keeping their storage.
     pub(crate) fn clear(&mut self) {
-        self.points.clear();
+        self.len = 0;
+        self.owner.clear();
     }
 
     /// Number of gathered points.
     pub(crate) fn len(&self) -> usize {
-        self.points.len()
+        self.len
     }
 
     /// Adds a source point `y` (normal `n`, quadrature weight `w`) of panel
@@ -108,13 +99,26 @@ impl SourcePoints {
         slot: usize,
         panel: usize,
     ) {
-        self.points.push(SourcePoint { x, nx, y, n, w, slot: slot as u32, panel: panel as u32 });
+        let (block, i) = (self.len / CHUNK, self.len % CHUNK);
+        if block == self.chunks.len() {
+            self.chunks.push(Box::default());
+        }
+        let cols = &mut self.chunks[block];
+        for k in 0..3 {
+            cols.x[k][i] = x[k];
+            cols.nx[k][i] = nx[k];
+            cols.y[k][i] = y[k];
+            cols.n[k][i] = n[k];
+        }
+        cols.w[i] = w;
+        self.len += 1;
+        self.owner.push((slot as u32, panel as u32));
     }
 
     /// The row entry and mesh panel (or cluster) of each gathered point, in
     /// order.
     pub(crate) fn owners(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        self.points.iter().map(|p| (p.slot as usize, p.panel as usize))
+        self.owner.iter().map(|&(slot, panel)| (slot as usize, panel as usize))
     }
 
     /// `(a, op)` of gathered point `p` (after [`SourcePoints::evaluate`]).
@@ -147,11 +151,9 @@ impl SourcePoints {
             }
         }
         let c = Coefficients::new(kernels);
-        let columns = self.columns.get_or_insert_with(Box::default);
-        for (start, chunk) in (0..n).step_by(CHUNK).zip(self.points.chunks(CHUNK)) {
-            columns.fill(chunk);
-            let columns = &**columns;
-            let end = start + chunk.len();
+        for (start, columns) in (0..n).step_by(CHUNK).zip(&self.chunks) {
+            let end = n.min(start + CHUNK);
+            let columns = (&**columns, end - start);
             let ([a_re, a_im], [op_re, op_im], [q_re, q_im]) = (&mut self.a, &mut self.op, &mut self.q);
             let out = Outputs {
                 a: [&mut a_re[start..end], &mut a_im[start..end]],
@@ -168,12 +170,12 @@ impl SourcePoints {
 }
 
 /// [`evaluate_lanes`] of formula `F` with `trig`.
-fn evaluate_with<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>, trig: Trig) {
+fn evaluate_with<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>, trig: Trig) {
     match trig {
-        Trig::Libm => evaluate_lanes::<F, true>(c, cols, out),
-        Trig::Polynomial => evaluate_polynomial::<F>(c, cols, out),
+        Trig::Libm => evaluate_lanes::<F, true>(c, (cols, n), out),
+        Trig::Polynomial => evaluate_polynomial::<F>(c, (cols, n), out),
         #[cfg(test)]
-        Trig::PolynomialPortable => evaluate_lanes::<F, false>(c, cols, out),
+        Trig::PolynomialPortable => evaluate_lanes::<F, false>(c, (cols, n), out),
     }
 }
 
@@ -189,36 +191,19 @@ enum Trig {
     PolynomialPortable,
 }
 
-/// A chunk of points as columns (structure of arrays), `len` of them.
+/// A block of points as columns (structure of arrays).
 struct Columns {
     x: [[f64; CHUNK]; 3],
     nx: [[f64; CHUNK]; 3],
     y: [[f64; CHUNK]; 3],
     n: [[f64; CHUNK]; 3],
     w: [f64; CHUNK],
-    len: usize,
 }
 
 impl Default for Columns {
     fn default() -> Self {
         let zero = [[0.0; CHUNK]; 3];
-        Columns { x: zero, nx: zero, y: zero, n: zero, w: [0.0; CHUNK], len: 0 }
-    }
-}
-
-impl Columns {
-    fn fill(&mut self, chunk: &[SourcePoint]) {
-        debug_assert!(chunk.len() <= CHUNK);
-        self.len = chunk.len();
-        for (i, p) in chunk.iter().enumerate() {
-            for k in 0..3 {
-                self.x[k][i] = p.x[k];
-                self.nx[k][i] = p.nx[k];
-                self.y[k][i] = p.y[k];
-                self.n[k][i] = p.n[k];
-            }
-            self.w[i] = p.w;
-        }
+        Columns { x: zero, nx: zero, y: zero, n: zero, w: [0.0; CHUNK] }
     }
 }
 
@@ -245,29 +230,32 @@ impl Coefficients {
 
 /// [`evaluate_lanes`] with the vectorizable `sin_cos`, compiled for AVX2
 /// (four f64 lanes) when the CPU has it.
-fn evaluate_polynomial<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
+fn evaluate_polynomial<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: evaluate_avx2's one requirement, AVX2, was just detected.
-        unsafe { evaluate_avx2::<F>(c, cols, out) };
+        unsafe { evaluate_avx2::<F>(c, (cols, n), out) };
         return;
     }
-    evaluate_lanes::<F, false>(c, cols, out);
+    evaluate_lanes::<F, false>(c, (cols, n), out);
 }
 
 /// [`evaluate_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn evaluate_avx2<const F: u8>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
-    evaluate_lanes::<F, false>(c, cols, out);
+fn evaluate_avx2<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>) {
+    evaluate_lanes::<F, false>(c, (cols, n), out);
 }
 
 /// The loop the compiler vectorizes (module doc): every slice cut to the
 /// same length so that no bounds check is left inside; the formula and
 /// the `sin_cos` are chosen at compile time.
 #[inline(always)]
-fn evaluate_lanes<const F: u8, const LIBM: bool>(c: &Coefficients, cols: &Columns, out: Outputs<'_>) {
-    let n = cols.len;
+fn evaluate_lanes<const F: u8, const LIBM: bool>(
+    c: &Coefficients,
+    (cols, n): (&Columns, usize),
+    out: Outputs<'_>,
+) {
     let (x0, x1, x2) = (&cols.x[0][..n], &cols.x[1][..n], &cols.x[2][..n]);
     let (m0, m1, m2) = (&cols.nx[0][..n], &cols.nx[1][..n], &cols.nx[2][..n]);
     let (y0, y1, y2) = (&cols.y[0][..n], &cols.y[1][..n], &cols.y[2][..n]);
