@@ -138,11 +138,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         modal_radiation::modes::radiate_modes_on(&bank, &mesh, &modes, &opts, &mut |p| eprintln!("{p}"))?;
     let mut out = Vec::with_capacity(results.len());
     for r in &results {
-        let mut pressure = Vec::with_capacity(args.point.len());
-        for p in &args.point {
-            let z = r.pressure_at(*p)?;
-            pressure.push([z.re, z.im]);
-        }
+        let pressure = r.pressures_at(&args.point)?.iter().map(|z| [z.re, z.im]).collect();
         out.push(ModeJson {
             index: r.mode,
             frequency_hz: r.frequency_hz,

@@ -151,7 +151,7 @@ impl Kernels {
         f: &impl Fn([f64; 3], f64) -> T,
     ) -> T {
         let split = |centroid: [f64; 3], diam: f64, depth: usize| {
-            depth < MAX_DEPTH && norm(sub(centroid, x)) < NEAR_RATIO * diam
+            depth < MAX_DEPTH && within_split_reach(centroid, diam, x)
         };
         let mut out = T::default();
         split_and_sum(
@@ -450,6 +450,23 @@ impl StaticIntegrals {
     }
 }
 
+/// Whether [`Kernels::adaptive`] splits triangle `t` (diameter `diam`)
+/// seen from `x`, or integrates it by the 7-point rule alone.
+pub(crate) fn adaptive_splits(t: [[f64; 3]; 3], diam: f64, x: [f64; 3]) -> bool {
+    within_split_reach(centroid(t), diam, x)
+}
+
+/// The adaptive rule's split test: `x` closer than [`NEAR_RATIO`]
+/// diameters to the (sub)panel's centroid.
+fn within_split_reach(centroid: [f64; 3], diam: f64, x: [f64; 3]) -> bool {
+    norm(sub(centroid, x)) < NEAR_RATIO * diam
+}
+
+/// The centroid of triangle `t`, as [`split_and_sum`] computes it.
+fn centroid(t: [[f64; 3]; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0)
+}
+
 /// `∫ f` over triangle `t` (area `area`, diameter `diam`) by the 7-point
 /// rule, split in four while `split(centroid, diameter, depth)` holds.
 fn split_and_sum<T: std::ops::AddAssign>(
@@ -461,8 +478,7 @@ fn split_and_sum<T: std::ops::AddAssign>(
     f: &impl Fn([f64; 3], f64) -> T,
     out: &mut T,
 ) {
-    let centroid = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
-    if split(centroid, diam, depth) {
+    if split(centroid(t), diam, depth) {
         let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
         let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
         for child in [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]] {

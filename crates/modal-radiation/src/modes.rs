@@ -87,6 +87,12 @@ impl ModeRadiation {
     pub fn pressure_at(&self, x: [f64; 3]) -> Result<c64, RadiationError> {
         self.surface.pressure_at(&self.mesh, x)
     }
+
+    /// [`ModeRadiation::pressure_at`] at each of `points`, in parallel
+    /// ([`SurfaceField::pressures_at`]).
+    pub fn pressures_at(&self, points: &[[f64; 3]]) -> Result<Vec<c64>, RadiationError> {
+        self.surface.pressures_at(&self.mesh, points)
+    }
 }
 
 /// Progress of a run, for the caller to show.
