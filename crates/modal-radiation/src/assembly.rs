@@ -27,6 +27,10 @@
 //!   one panel, and the far part costs one `sincos` per pair of clusters
 //!   instead of one per (cluster, panel): `n²` instead of `n·N`.
 //!
+//! The kernel points of the fixed rules (centroid, 3-point, the near
+//! remainder's 7 points, the far clusters' centroids) are gathered as a
+//! row is swept and evaluated together in SIMD lanes ([`crate::batch`]).
+//!
 //! Rows are assembled in parallel, each by one thread in a fixed order:
 //! bit-identical for any thread count.
 
