@@ -311,9 +311,14 @@ pub const ITERATIVE_MIN_UNKNOWNS: usize = 800;
 /// ([`crate::hmatrix`]) and solved by GMRES on it. Measured on the demo
 /// bowl (release, load 5–7): at 5 754 unknowns on 25 344 panels (21.1 kHz,
 /// no cluster summed as a point) 33 s against 46 s dense; at 5 251
-/// (5.3 kHz, far clusters summed as points) both about 19 s; smaller
-/// systems compress too little to gain.
-pub const HMATRIX_MIN_UNKNOWNS: usize = 4000;
+/// (5.3 kHz, far clusters summed as points) both about 19 s. Once the
+/// kernel points were evaluated in SIMD lanes ([`crate::batch`]) the dense
+/// products' memory traffic weighed more than the assembly, and from
+/// 2 000 (was 4 000) the demo's modes ≤ 6 kHz took, two pairs: bar 5.15 /
+/// 5.16 → 4.63 / 4.62 s user, bowl 13.5 / 13.6 → 13.3 / 13.3 s, levels
+/// within 0.042 dB (the ACA tolerance's budget is 0.1 dB); 1 200 was the
+/// same as 2 000 (no demo group lies between).
+pub const HMATRIX_MIN_UNKNOWNS: usize = 2000;
 
 /// Largest system assembled dense (16 B × n²: 6 000 unknowns ≈ 0.58 GB):
 /// the fallback when GMRES on the compressed matrix does not converge.
