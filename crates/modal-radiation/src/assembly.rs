@@ -185,9 +185,6 @@ pub(crate) struct Assembly<'a> {
     regions: Vec<Region>,
     sources: Vec<SourcePanel>,
     moments: Vec<Vec<Moments>>,
-    /// Whether every `k·r` on the surface is within the batched `sin_cos`'s
-    /// range ([`crate::sincos::MAX_ARGUMENT`]).
-    lanes: bool,
 }
 
 impl<'a> Assembly<'a> {
@@ -228,10 +225,7 @@ impl<'a> Assembly<'a> {
             })
             .collect();
         let coupled = CoupledKernels::new(kern.k(), alpha);
-        // Two surface points are at most twice the radius about the centroid apart.
-        let span = 2.0 * mesh.radius_about(mesh.surface_centroid());
-        let lanes = kern.k() * span <= crate::sincos::MAX_ARGUMENT;
-        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments, lanes }
+        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments }
     }
 
     /// Number of unknowns (clusters).
@@ -315,7 +309,7 @@ impl<'a> Assembly<'a> {
         }
         let region = &self.regions[i];
         let nrhs = self.q.len().max(1);
-        pts.evaluate(&self.coupled, Formula::Linear, !self.lanes);
+        pts.evaluate(&self.coupled, Formula::Linear);
         for (p, (slot, c)) in pts.owners().enumerate() {
             let (dn, nn, op) = pts.linear_weights(p);
             let src = &self.regions[c];
@@ -335,7 +329,7 @@ impl<'a> Assembly<'a> {
             return;
         }
         let nrhs = self.q.len().max(1);
-        pts.evaluate(&self.coupled, formula, !self.lanes);
+        pts.evaluate(&self.coupled, formula);
         for (p, (slot, panel)) in pts.owners().enumerate() {
             let (a, op) = pts.weights(p);
             row[slot] += a;

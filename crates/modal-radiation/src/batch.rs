@@ -27,10 +27,12 @@
 //! IEEE operations in the same order either way, so the result does not
 //! depend on the lane width (nor on the thread count).
 
+use std::ops::Range;
+
 use faer::c64;
 
 use crate::kernels::CoupledKernels;
-use crate::sincos::sin_cos;
+use crate::sincos::{sin_cos, MAX_ARGUMENT};
 
 const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 
@@ -136,10 +138,11 @@ impl SourcePoints {
     }
 
     /// Evaluates every gathered point's `(a, op)` by `formula`; no point
-    /// at its observer. `libm_trig` takes libm's `sin_cos`, point by point,
-    /// for surfaces where some `k·r` exceeds [`crate::sincos::MAX_ARGUMENT`].
-    pub(crate) fn evaluate(&mut self, kernels: &CoupledKernels, formula: Formula, libm_trig: bool) {
-        self.evaluate_by(kernels, formula, if libm_trig { Trig::Libm } else { Trig::Polynomial });
+    /// at its observer. A block with some `k·r` beyond
+    /// [`crate::sincos::MAX_ARGUMENT`] (a field point far away) is
+    /// evaluated again with libm's `sin_cos`.
+    pub(crate) fn evaluate(&mut self, kernels: &CoupledKernels, formula: Formula) {
+        self.evaluate_by(kernels, formula, Trig::Polynomial);
     }
 
     /// [`SourcePoints::evaluate`] with `trig`.
@@ -150,27 +153,46 @@ impl SourcePoints {
                 v.resize(n, 0.0);
             }
         }
-        let c = Coefficients::new(kernels);
-        for (start, columns) in (0..n).step_by(CHUNK).zip(&self.chunks) {
+        for start in (0..n).step_by(CHUNK) {
             let end = n.min(start + CHUNK);
-            let columns = (&**columns, end - start);
-            let ([a_re, a_im], [op_re, op_im], [q_re, q_im]) = (&mut self.a, &mut self.op, &mut self.q);
-            let out = Outputs {
-                a: [&mut a_re[start..end], &mut a_im[start..end]],
-                op: [&mut op_re[start..end], &mut op_im[start..end]],
-                q: [&mut q_re[start..end], &mut q_im[start..end]],
-            };
-            match formula {
-                Formula::Coupled => evaluate_with::<COUPLED>(&c, columns, out, trig),
-                Formula::Remainder => evaluate_with::<REMAINDER>(&c, columns, out, trig),
-                Formula::Linear => evaluate_with::<LINEAR>(&c, columns, out, trig),
+            if !self.evaluate_block(kernels, formula, trig, start..end) {
+                self.evaluate_block(kernels, formula, Trig::Libm, start..end);
             }
+        }
+    }
+
+    /// Points `range` (one block of columns) by `formula` with `trig`;
+    /// false when some `k·r` was beyond the polynomial `sin_cos`'s range.
+    fn evaluate_block(
+        &mut self,
+        c: &CoupledKernels,
+        formula: Formula,
+        trig: Trig,
+        range: Range<usize>,
+    ) -> bool {
+        let columns = (&*self.chunks[range.start / CHUNK], range.len());
+        let ([a_re, a_im], [op_re, op_im], [q_re, q_im]) = (&mut self.a, &mut self.op, &mut self.q);
+        let out = Outputs {
+            a: [&mut a_re[range.clone()], &mut a_im[range.clone()]],
+            op: [&mut op_re[range.clone()], &mut op_im[range.clone()]],
+            q: [&mut q_re[range.clone()], &mut q_im[range]],
+        };
+        match formula {
+            Formula::Coupled => evaluate_with::<COUPLED>(c, columns, out, trig),
+            Formula::Remainder => evaluate_with::<REMAINDER>(c, columns, out, trig),
+            Formula::Linear => evaluate_with::<LINEAR>(c, columns, out, trig),
         }
     }
 }
 
-/// [`evaluate_lanes`] of formula `F` with `trig`.
-fn evaluate_with<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>, trig: Trig) {
+/// [`evaluate_lanes`] of formula `F` with `trig`; false when some `k·r`
+/// was beyond the polynomial `sin_cos`'s range.
+fn evaluate_with<const F: u8>(
+    c: &CoupledKernels,
+    (cols, n): (&Columns, usize),
+    out: Outputs<'_>,
+    trig: Trig,
+) -> bool {
     match trig {
         Trig::Libm => evaluate_lanes::<F, true>(c, (cols, n), out),
         Trig::Polynomial => evaluate_polynomial::<F>(c, (cols, n), out),
@@ -214,48 +236,40 @@ struct Outputs<'a> {
     q: [&'a mut [f64]; 2],
 }
 
-/// The kernels' scalars: `k`, `α` and `iα` as real and imaginary parts.
-struct Coefficients {
-    k: f64,
-    alpha: [f64; 2],
-    i_alpha: [f64; 2],
-}
-
-impl Coefficients {
-    fn new(kernels: &CoupledKernels) -> Coefficients {
-        let (alpha, i_alpha) = (kernels.alpha(), kernels.i_alpha());
-        Coefficients { k: kernels.k(), alpha: [alpha.re, alpha.im], i_alpha: [i_alpha.re, i_alpha.im] }
-    }
-}
-
 /// [`evaluate_lanes`] with the vectorizable `sin_cos`, compiled for AVX2
 /// (four f64 lanes) when the CPU has it.
-fn evaluate_polynomial<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>) {
+fn evaluate_polynomial<const F: u8>(
+    c: &CoupledKernels,
+    (cols, n): (&Columns, usize),
+    out: Outputs<'_>,
+) -> bool {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: evaluate_avx2's one requirement, AVX2, was just detected.
-        unsafe { evaluate_avx2::<F>(c, (cols, n), out) };
-        return;
+        return unsafe { evaluate_avx2::<F>(c, (cols, n), out) };
     }
-    evaluate_lanes::<F, false>(c, (cols, n), out);
+    evaluate_lanes::<F, false>(c, (cols, n), out)
 }
 
 /// [`evaluate_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn evaluate_avx2<const F: u8>(c: &Coefficients, (cols, n): (&Columns, usize), out: Outputs<'_>) {
-    evaluate_lanes::<F, false>(c, (cols, n), out);
+fn evaluate_avx2<const F: u8>(c: &CoupledKernels, (cols, n): (&Columns, usize), out: Outputs<'_>) -> bool {
+    evaluate_lanes::<F, false>(c, (cols, n), out)
 }
 
 /// The loop the compiler vectorizes (module doc): every slice cut to the
 /// same length so that no bounds check is left inside; the formula and
-/// the `sin_cos` are chosen at compile time.
+/// the `sin_cos` are chosen at compile time. False when the polynomial
+/// `sin_cos` met some `k·r` beyond its range (the results are then wrong).
 #[inline(always)]
 fn evaluate_lanes<const F: u8, const LIBM: bool>(
-    c: &Coefficients,
+    c: &CoupledKernels,
     (cols, n): (&Columns, usize),
     out: Outputs<'_>,
-) {
+) -> bool {
+    let k = c.k();
+    let mut beyond = 0u64;
     let (x0, x1, x2) = (&cols.x[0][..n], &cols.x[1][..n], &cols.x[2][..n]);
     let (m0, m1, m2) = (&cols.nx[0][..n], &cols.nx[1][..n], &cols.nx[2][..n]);
     let (y0, y1, y2) = (&cols.y[0][..n], &cols.y[1][..n], &cols.y[2][..n]);
@@ -268,7 +282,8 @@ fn evaluate_lanes<const F: u8, const LIBM: bool>(
         let d = [y0[i] - x0[i], y1[i] - x1[i], y2[i] - x2[i]];
         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let r = r2.sqrt();
-        let kr = c.k * r;
+        let kr = k * r;
+        beyond |= u64::from(kr > MAX_ARGUMENT);
         let (sn, cs) = if LIBM { kr.sin_cos() } else { sin_cos(kr) };
         let point = Point {
             kr,
@@ -290,6 +305,7 @@ fn evaluate_lanes<const F: u8, const LIBM: bool>(
         };
         (a_re[i], a_im[i], op_re[i], op_im[i]) = (a[0], a[1], op[0], op[1]);
     }
+    LIBM || beyond == 0
 }
 
 /// One source point's geometry seen from its observer: `k·r`, `e^{ikr}`,
@@ -304,6 +320,12 @@ struct Point {
     nxny: f64,
 }
 
+/// A complex number as `[re, im]`.
+#[inline(always)]
+fn parts(z: c64) -> [f64; 2] {
+    [z.re, z.im]
+}
+
 /// `(a·b)` of complex numbers as `[re, im]`.
 #[inline(always)]
 fn mul(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
@@ -313,9 +335,9 @@ fn mul(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
 impl Point {
     /// `(a, op)` of the coupled kernels (module doc).
     #[inline(always)]
-    fn coupled(&self, c: &Coefficients) -> ([f64; 2], [f64; 2]) {
+    fn coupled(&self, c: &CoupledKernels) -> ([f64; 2], [f64; 2]) {
         let Point { kr, e, scale, u, dny, dnx, nxny } = *self;
-        let (al, ia) = (c.alpha, c.i_alpha);
+        let (al, ia) = (parts(c.alpha()), parts(c.i_alpha()));
         let gw = [e[0] * scale, e[1] * scale];
         let alpha_t = [ia[0] * kr - al[0], ia[1] * kr - al[1]];
         let (f, g) = (3.0 - kr * kr, 3.0 * kr);
@@ -331,9 +353,9 @@ impl Point {
 
     /// `(P, Q, op)` of [`Formula::Linear`].
     #[inline(always)]
-    fn linear(&self, c: &Coefficients) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    fn linear(&self, c: &CoupledKernels) -> ([f64; 2], [f64; 2], [f64; 2]) {
         let Point { kr, e, scale, u, dnx, .. } = *self;
-        let (al, ia) = (c.alpha, c.i_alpha);
+        let (al, ia) = (parts(c.alpha()), parts(c.i_alpha()));
         let gwu = [e[0] * scale * u, e[1] * scale * u];
         let alpha_t = [ia[0] * kr - al[0], ia[1] * kr - al[1]];
         let (f, g) = (3.0 - kr * kr, 3.0 * kr);
@@ -347,9 +369,9 @@ impl Point {
 
     /// `(a, op)` of the remainder kernels (module doc).
     #[inline(always)]
-    fn remainder(&self, c: &Coefficients) -> ([f64; 2], [f64; 2]) {
+    fn remainder(&self, c: &CoupledKernels) -> ([f64; 2], [f64; 2]) {
         let Point { kr, e, scale, u, dny, dnx, nxny } = *self;
-        let al = c.alpha;
+        let al = parts(c.alpha());
         let h = 0.5 * kr * kr;
         let su = scale * u;
         // R₁ = [e(ikr − 1) + 1 + h]/(4πr³), times w.
@@ -403,26 +425,32 @@ mod tests {
         assert!((got - want).norm() <= 1e-13 * want.norm(), "{what}: {got} vs {want}");
     }
 
+    /// `(a, op)` from the four kernels of [`Kernels::point`], combined:
+    /// the independent reference of the coupled formula.
+    fn combined(k: f64, alpha: c64, (x, nx): Observer, (y, ny, w): Source) -> (c64, c64) {
+        let ints = Kernels::new(k).point(x, nx, y, ny, w);
+        (-ints.dg_dny - alpha * ints.d2g, -(ints.g + alpha * ints.dg_dnx))
+    }
+
     #[test]
-    fn coupled_weights_equal_the_point_kernel_in_every_lane_width() {
-        let kernels = CoupledKernels::new(300.0, c64::new(0.0, 1.0 / 300.0));
+    fn coupled_weights_equal_the_kernels_combined_in_every_lane_width() {
+        let (k, alpha) = (300.0, c64::new(0.0, 1.0 / 300.0));
+        let kernels = CoupledKernels::new(k, alpha);
         let observers = [([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]), ([0.2, 0.1, -0.1], [1.0, 0.0, 0.0])];
         let (mut pts, sources) = gathered(observers);
-        pts.evaluate(&kernels, Formula::Coupled, false);
+        pts.evaluate(&kernels, Formula::Coupled);
         let wide = (0..pts.len()).map(|p| pts.weights(p)).collect::<Vec<_>>();
         // The portable loop (two lanes) gives the same bits as the run-time choice.
         pts.evaluate_by(&kernels, Formula::Coupled, Trig::PolynomialPortable);
         for (p, (a, op)) in wide.iter().enumerate() {
             assert_eq!((*a, *op), pts.weights(p), "point {p}");
-            let (x, nx) = observers[p % 2];
-            let (y, ny, w) = sources[p / 2];
-            let (a0, op0) = kernels.point(x, nx, y, ny, w);
+            let (a0, op0) = combined(k, alpha, observers[p % 2], sources[p / 2]);
             close(*a, a0, &format!("a at point {p}"));
             close(*op, op0, &format!("op at point {p}"));
         }
         assert_eq!(pts.owners().nth(73), Some((2, 36)));
-        // libm's sin_cos (surfaces beyond the polynomial's range) agrees too.
-        pts.evaluate(&kernels, Formula::Coupled, true);
+        // libm's sin_cos agrees too.
+        pts.evaluate_by(&kernels, Formula::Coupled, Trig::Libm);
         for (p, (a, op)) in wide.iter().enumerate() {
             let (a1, op1) = pts.weights(p);
             close(a1, *a, &format!("libm a at point {p}"));
@@ -431,12 +459,52 @@ mod tests {
     }
 
     #[test]
+    fn coupled_weights_of_random_pairs_equal_the_kernels_combined() {
+        // Random pairs at kr from 0.05 to 60, any orientation, and pairs 1 km
+        // apart (k·r beyond the polynomial sin_cos: the block takes libm's).
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rand = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let unit = |v: [f64; 3]| v.map(|c| c / crate::geometry::norm(v));
+        let mut fallbacks = 0;
+        for case in 0..300 {
+            let k = [1.0, 30.0, 300.0][case % 3];
+            let alpha = c64::new(0.0, 1.0 / k) * (1.0 + rand());
+            let x = [rand(), rand(), rand()];
+            let reach = if case >= 200 { 1000.0 } else { 0.2 };
+            let y = [0, 1, 2].map(|i| x[i] + reach * rand());
+            let (nx, ny) = (unit([rand(), rand(), rand()]), unit([rand(), rand(), rand()]));
+            let w = 1e-4 * (1.0 + rand());
+            let mut pts = SourcePoints::default();
+            pts.push((x, nx), y, ny, w, 0, 0);
+            let kernels = CoupledKernels::new(k, alpha);
+            let beyond = k * crate::geometry::norm(crate::geometry::sub(y, x)) > MAX_ARGUMENT;
+            pts.evaluate(&kernels, Formula::Coupled);
+            // The polynomial pass reports the argument out of its range.
+            assert_eq!(pts.evaluate_block(&kernels, Formula::Coupled, Trig::Polynomial, 0..1), !beyond);
+            if beyond {
+                fallbacks += 1;
+                pts.evaluate(&kernels, Formula::Coupled);
+            }
+            let (got, want) = (pts.weights(0), combined(k, alpha, (x, nx), (y, ny, w)));
+            for (g, e) in [(got.0, want.0), (got.1, want.1)] {
+                assert!((g - e).norm() <= 1e-13 * e.norm(), "case {case}: {g} vs {e}");
+            }
+        }
+        assert!(fallbacks > 10, "{fallbacks} pairs beyond the polynomial's range");
+    }
+
+    #[test]
     fn linear_coefficients_give_the_point_kernel_for_any_normal() {
         let (k, alpha) = (250.0, c64::new(0.0, 1.0 / 250.0));
         let kernels = CoupledKernels::new(k, alpha);
         let observers = [([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]), ([0.2, 0.1, -0.1], [1.0, 0.0, 0.0])];
         let (mut pts, sources) = gathered(observers);
-        pts.evaluate(&kernels, Formula::Linear, false);
+        pts.evaluate(&kernels, Formula::Linear);
         for p in 0..pts.len() {
             let (x, nx) = observers[p % 2];
             let (y, ny, w) = sources[p / 2];
@@ -467,7 +535,7 @@ mod tests {
             for (b, w) in crate::quadrature::TRIANGLE_7 {
                 pts.push((x, nx), crate::quadrature::on_triangle(b, t), panel.normal, w * panel.area, 0, 0);
             }
-            pts.evaluate(&kernels, Formula::Remainder, false);
+            pts.evaluate(&kernels, Formula::Remainder);
             let (mut a, mut op) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
             for p in 0..pts.len() {
                 let (da, dop) = pts.weights(p);

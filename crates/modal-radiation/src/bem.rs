@@ -43,7 +43,7 @@ pub use crate::assembly::{AGGREGATE_RATIO, CLUSTER_NEAR_RATIO, FAR_POINT_RATIO, 
 use crate::batch::{Formula, SourcePoints};
 use crate::cluster::Clusters;
 use crate::error::RadiationError;
-use crate::geometry::{norm, sub, BoundaryMesh};
+use crate::geometry::BoundaryMesh;
 use crate::hmatrix::HMatrix;
 use crate::kernels::{CoupledKernels, Kernels};
 use crate::near::NearField;
@@ -171,12 +171,9 @@ impl SurfaceField {
         const REPRESENTATION_SLAB: usize = 4096;
         let kern = Kernels::new(self.wavenumber);
         let plain = CoupledKernels::new(self.wavenumber, c64::new(0.0, 0.0));
-        let centre = mesh.surface_centroid();
-        let reach = norm(sub(x, centre)) + mesh.radius_about(centre);
-        let libm_trig = self.wavenumber * reach > crate::sincos::MAX_ARGUMENT;
         let mut p = c64::new(0.0, 0.0);
         let flush = |pts: &mut SourcePoints, p: &mut c64| {
-            pts.evaluate(&plain, Formula::Coupled, libm_trig);
+            pts.evaluate(&plain, Formula::Coupled);
             for (i, (_, j)) in pts.owners().enumerate() {
                 let (a, op) = pts.weights(i);
                 *p += self.dpdn(j) * op - self.pressure[j] * a;

@@ -335,7 +335,8 @@ impl PointKernel {
 /// `op = −G w [1 − αt (d·n_x) u]`, where `αt = −α + kr·iα` and
 /// `αs = (3 − k²r²)α − 3kr·iα` need only real multiples of `α` and `iα`:
 /// two complex products per point instead of the eight of
-/// [`Kernels::point`] and the coupling.
+/// [`Kernels::point`] and the coupling. [`crate::batch`] evaluates it,
+/// many points at a time.
 #[derive(Clone, Copy, Debug)]
 pub struct CoupledKernels {
     k: f64,
@@ -362,24 +363,6 @@ impl CoupledKernels {
     /// `iα`.
     pub(crate) fn i_alpha(&self) -> c64 {
         self.i_alpha
-    }
-
-    /// `(a, op)` of one source point (type doc); `y ≠ x`.
-    #[inline]
-    pub fn point(&self, x: [f64; 3], nx: [f64; 3], y: [f64; 3], ny: [f64; 3], w: f64) -> (c64, c64) {
-        let d = sub(y, x);
-        let r2 = dot(d, d);
-        let r = r2.sqrt();
-        let kr = self.k * r;
-        let (sn, cs) = kr.sin_cos();
-        let gw = c64::new(cs, sn) * (w / (FOUR_PI * r));
-        let u = 1.0 / r2;
-        let (dny, dnx) = (dot(d, ny), dot(d, nx));
-        let t = c64::new(-1.0, kr);
-        let alpha_t = self.i_alpha * kr - self.alpha;
-        let alpha_s = self.alpha * (3.0 - kr * kr) - self.i_alpha * (3.0 * kr);
-        let bracket = t * dny - alpha_t * dot(nx, ny) - alpha_s * (dnx * dny * u);
-        (-(gw * u) * bracket, -gw * (c64::new(1.0, 0.0) - alpha_t * (dnx * u)))
     }
 }
 
@@ -557,34 +540,6 @@ mod tests {
     /// the 3-point rule stays ≤ 6e-3 out to 16 diameters; the adaptive
     /// rule it is compared with is itself within 2e-5 there (7 points on
     /// the whole panel against 7 on each of 256 sub-triangles).
-    #[test]
-    fn coupled_kernels_are_the_kernels_coupled() {
-        // Random pairs at kr from 0.05 to 60, any orientation: the fused
-        // weights equal the four kernels combined, to rounding.
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rand = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        let unit = |v: [f64; 3]| v.map(|c| c / norm(v));
-        for case in 0..200 {
-            let k = [1.0, 30.0, 300.0][case % 3];
-            let alpha = c64::new(0.0, 1.0 / k) * (1.0 + rand());
-            let x = [rand(), rand(), rand()];
-            let y = [0, 1, 2].map(|i| x[i] + 0.2 * rand());
-            let (nx, ny) = (unit([rand(), rand(), rand()]), unit([rand(), rand(), rand()]));
-            let w = 1e-4 * (1.0 + rand());
-            let ints = Kernels::new(k).point(x, nx, y, ny, w);
-            let want = (-ints.dg_dny - alpha * ints.d2g, -(ints.g + alpha * ints.dg_dnx));
-            let got = CoupledKernels::new(k, alpha).point(x, nx, y, ny, w);
-            for (g, e) in [(got.0, want.0), (got.1, want.1)] {
-                assert!((g - e).norm() <= 1e-13 * e.norm(), "case {case}: {g} vs {e}");
-            }
-        }
-    }
-
     #[test]
     fn far_rules_meet_their_stated_error() {
         use crate::bem::{FAR_POINT_RATIO, MID_POINT_RATIO};
