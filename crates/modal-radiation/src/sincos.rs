@@ -26,10 +26,12 @@ const PIO2_3: f64 = 2.0222662487959506e-21;
 /// Adding it rounds to an integer held in the low mantissa bits.
 const ROUND_MAGIC: f64 = 6755399441055744.0;
 
-/// `(sin x, cos x)` for `|x| ≤` [`MAX_ARGUMENT`] (module doc).
+/// `(sin x, cos x)` for `|x| ≤` [`MAX_ARGUMENT`] (module doc); beyond it
+/// the result loses accuracy, and the caller checks the range itself
+/// ([`crate::batch`] tests `k·r` in the same loop and evaluates such a
+/// block again with libm), since a check here could not be vectorized.
 #[inline(always)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
-    debug_assert!(x.abs() <= MAX_ARGUMENT || !x.is_finite());
     let shifted = x * TWO_OVER_PI + ROUND_MAGIC;
     let n = shifted - ROUND_MAGIC;
     let quadrant = shifted.to_bits();
