@@ -449,3 +449,55 @@ fn surface_assets_get_the_error_estimate_unless_the_manifest_turns_it_off() {
     let (_, plain) = estimate("plain");
     assert!(plain.is_empty(), "accuracy = \"off\": no estimate, got {plain:?}");
 }
+
+/// `transfer_max_freq` stores each audible mode's acoustic transfer in the
+/// bank, the same table `modal radiation --max-freq F --store` writes for
+/// that bank; a rerun reuses it, a changed frequency solves it again, and
+/// `transfer_max_freq = 0` on an asset turns the `[defaults]` off.
+#[test]
+fn a_manifest_can_bake_each_audible_modes_transfer_into_its_bank() {
+    let dir = temp_dir();
+    let d = dir.path();
+    boxes(d, 2, "0.03");
+    let write = |top: &str| {
+        let text = format!(
+            "[defaults]\nmaterial = \"steel\"\norder = 1\nmodes = 4\nmax_freq = 200000\ntransfer_max_freq = {top}\n\n\
+             [[assets]]\npath = \"props/box_00.msh\"\n\n\
+             [[assets]]\npath = \"props/box_01.msh\"\ntransfer_max_freq = 0\n"
+        );
+        std::fs::write(d.join("library.toml"), text).unwrap();
+    };
+    let args = ["precompute-batch", "library.toml", "--out", "out", "--cache-dir", "cache", "--json"];
+    let transfer = |summary: &Value| -> Vec<(u64, bool)> {
+        entries(summary)
+            .iter()
+            .map(|e| (e["transfer_modes"].as_u64().unwrap(), e["cached"] == true))
+            .collect()
+    };
+    let stored = |name: &str| modal_bank::ModeBank::load_with_radiation(d.join(name)).unwrap();
+
+    write("20000");
+    let first = modal(d, &args, &[]).ok().json();
+    let (bank, table) = stored("out/props/box_00.bank");
+    let audible: Vec<usize> = (0..bank.mode_count()).filter(|&i| bank.frequencies_hz[i] <= 20000.0).collect();
+    assert!(!audible.is_empty() && audible.len() < bank.mode_count(), "{:?}", bank.frequencies_hz);
+    let table = table.expect("box_00 stores its transfer");
+    assert_eq!(table.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), audible);
+    assert_eq!(transfer(&first), [(audible.len() as u64, false), (0, false)]);
+    assert!(stored("out/props/box_01.bank").1.is_none(), "transfer_max_freq = 0 stores none");
+
+    // The same table as `modal radiation --store` of the bank.
+    modal(d, &["radiation", "out/props/box_00.bank", "--max-freq", "20000", "--store", "cli.bank"], &[]).ok();
+    let via_cli = stored("cli.bank").1.expect("the CLI stores a table");
+    assert_eq!(via_cli, table, "the batch's table differs from `modal radiation --store`");
+
+    // A rerun reuses both banks; a new frequency solves box_00's transfer again.
+    assert_eq!(transfer(&modal(d, &args, &[]).ok().json()), [(audible.len() as u64, true), (0, true)]);
+    let lower = 0.5 * (bank.frequencies_hz[0] + bank.frequencies_hz[1]);
+    let below = bank.frequencies_hz.iter().filter(|&&f| f <= lower).count() as u64;
+    write(&format!("{lower}"));
+    assert_eq!(transfer(&modal(d, &args, &[]).ok().json()), [(below, false), (0, true)]);
+
+    write("-1");
+    modal(d, &["precompute-batch", "library.toml", "--out", "out"], &[]).fails_with("transfer_max_freq");
+}

@@ -175,16 +175,16 @@ fn write_table(catalogue: &Catalogue, out: &mut impl Write) -> std::io::Result<(
     let width = catalogue.assets.iter().map(|e| e.path.len()).max().unwrap_or(4).max(4);
     writeln!(
         out,
-        "{:<width$}  {:>5}  {:>10}  {:>8}  {:<6}  status",
-        "path", "modes", "f1 [Hz]", "seconds", "reused"
+        "{:<width$}  {:>5}  {:>10}  {:>8}  {:>8}  {:<6}  status",
+        "path", "modes", "f1 [Hz]", "transfer", "seconds", "reused"
     )?;
     for e in &catalogue.assets {
         let f1 = e.first_frequency_hz.map_or("-".to_string(), |f| format!("{f:.1}"));
         let reused = if e.cached { "yes" } else { "no" };
         writeln!(
             out,
-            "{:<width$}  {:>5}  {f1:>10}  {:>8.2}  {reused:<6}  {}",
-            e.path, e.modes, e.seconds, e.status
+            "{:<width$}  {:>5}  {f1:>10}  {:>8}  {:>8.2}  {reused:<6}  {}",
+            e.path, e.modes, e.transfer_modes, e.seconds, e.status
         )?;
     }
     Ok(())

@@ -53,7 +53,7 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
     super::radiation::check_field_points(bank, &mesh, &[x]).context("--listener")?;
     let audible: Vec<usize> = (0..bank.mode_count())
-        .filter(|&i| bank.damped_frequency_hz(i) >= super::radiation::AUDIBLE_MIN_HZ)
+        .filter(|&i| bank.damped_frequency_hz(i) >= modal_radiation::modes::AUDIBLE_MIN_HZ)
         .collect();
     let table = stored_radiation(path)?;
     if let Some(table) = table.filter(|_| !solve) {

@@ -13,9 +13,6 @@ use serde::Serialize;
 use super::bank_cmds::load_bank;
 use super::output::print_json;
 
-/// Lowest frequency treated as audible [Hz].
-pub const AUDIBLE_MIN_HZ: f64 = 20.0;
-
 #[derive(Debug, Args)]
 pub struct RadiationArgs {
     /// Mode bank.
@@ -112,10 +109,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     ensure!(args.cluster_kh.is_finite() && args.cluster_kh > 0.0, "--cluster-kh must be finite and positive");
     let mesh = modal_radiation::modes::boundary_mesh(&bank).context("the bank's surface cannot be used")?;
     check_field_points(&bank, &mesh, &args.point).context("--point")?;
-    let audible = |i: usize| {
-        let f = bank.damped_frequency_hz(i);
-        f >= AUDIBLE_MIN_HZ && bank.frequencies_hz[i] <= args.max_freq
-    };
+    let audible = |i: usize| modal_radiation::modes::is_audible(&bank, i, args.max_freq);
     for &m in &args.mode {
         ensure!(m < bank.mode_count(), "mode {m} does not exist (the bank has {} modes)", bank.mode_count());
     }

@@ -3,7 +3,7 @@
 //! `catalogue.json` (unsharded) or `catalogue-shard-I-of-N.json` (shard I of
 //! N; several shards can share one output directory) is
 //! `{"assets": [{"path", "bank", "hash", "modes", "first_frequency_hz",
-//! "seconds", "status", "cached"}], "pending": [...], "complete": bool,
+//! "transfer_modes", "seconds", "status", "cached"}], "pending": [...], "complete": bool,
 //! "shard": {"index", "count"} | null}`; the names are a contract.
 //!
 //! Entries are sorted by (`path`, `bank`, `hash`, `status`), so a catalogue
@@ -38,6 +38,10 @@ pub struct CatalogueEntry {
     pub modes: usize,
     /// Lowest mode's frequency \[Hz\]; `null` without modes.
     pub first_frequency_hz: Option<f64>,
+    /// Modes whose acoustic transfer the bank stores (the manifest's
+    /// `transfer_max_freq`; 0 without it or on failure).
+    #[serde(default)]
+    pub transfer_modes: usize,
     /// Wall time spent on the asset in this run \[s\].
     pub seconds: f64,
     /// `"ok"`, or the error message.
@@ -288,6 +292,7 @@ mod tests {
             hash: Some(format!("{:064x}", path.len())),
             modes: if ok { 4 } else { 0 },
             first_frequency_hz: ok.then_some(100.0 + path.len() as f64),
+            transfer_modes: if ok { 2 } else { 0 },
             seconds,
             status: status.into(),
             cached: false,

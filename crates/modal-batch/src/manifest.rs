@@ -61,6 +61,9 @@ pub struct Options {
     /// Per-mode error estimate of surface meshes and the accuracy to reach, as
     /// `modal precompute --accuracy` (unset everywhere: its default, 1 %).
     pub accuracy: Option<Accuracy>,
+    /// Store each audible mode's acoustic transfer up to this frequency
+    /// \[Hz\] in the bank, as `modal radiation --store` does (0: none).
+    pub transfer_max_freq: Option<f64>,
 }
 
 /// The `accuracy` key: a target in percent (`accuracy = 0.5`), or `accuracy = "off"`
@@ -114,6 +117,7 @@ impl Options {
             cell: self.cell.or(base.cell),
             part: self.part.clone().or_else(|| base.part.clone()),
             accuracy: self.accuracy.or(base.accuracy),
+            transfer_max_freq: self.transfer_max_freq.or(base.transfer_max_freq),
         }
     }
 }
@@ -141,6 +145,7 @@ struct Table {
     cell: Option<f64>,
     part: Option<String>,
     accuracy: Option<AccuracyKey>,
+    transfer_max_freq: Option<f64>,
 }
 
 impl Table {
@@ -160,6 +165,7 @@ impl Table {
             cell: self.cell,
             part: self.part.clone(),
             accuracy: self.accuracy.as_ref().map(AccuracyKey::parse).transpose()?,
+            transfer_max_freq: self.transfer_max_freq,
         })
     }
 
@@ -204,6 +210,9 @@ pub struct Asset {
     pub bank: String,
     /// The pipeline request (source file, material, order, band, mesher).
     pub request: Request,
+    /// Store each audible mode's acoustic transfer up to this frequency
+    /// \[Hz\] in the bank (`None`: no transfer).
+    pub transfer_max_hz: Option<f64>,
     /// Things the user should know (e.g. undamped material).
     pub warnings: Vec<String>,
 }
@@ -339,7 +348,17 @@ impl Manifest {
             Accuracy::Off => None,
         };
         check_request(&request, o)?;
-        Ok(Asset { path, bank, request, warnings })
+        let transfer_max_hz = match o.transfer_max_freq {
+            None => None,
+            Some(0.0) => None,
+            Some(f) if f.is_finite() && f > 0.0 => Some(f),
+            Some(f) => {
+                return Err(format!(
+                    "`transfer_max_freq` must be a positive frequency in Hz or 0 (none), got {f}"
+                ))
+            }
+        };
+        Ok(Asset { path, bank, request, transfer_max_hz, warnings })
     }
 }
 
@@ -504,6 +523,27 @@ mod tests {
             let e = accuracy(bad).unwrap_err().to_string();
             assert!(e.contains("`accuracy`") && e.contains("[defaults]"), "{bad}: {e}");
         }
+    }
+
+    #[test]
+    fn transfer_is_off_unless_asked_and_can_be_turned_off_per_asset() {
+        let base = Path::new(".");
+        let transfer = |defaults: &str, asset: &str| {
+            let text = format!(
+                "[defaults]\nmaterial = \"steel\"\n{defaults}\n[[assets]]\npath = \"a.obj\"\n{asset}"
+            );
+            resolve(&text, base).map(|(assets, _)| assets[0].transfer_max_hz)
+        };
+        assert_eq!(transfer("", "").unwrap(), None);
+        assert_eq!(transfer("transfer_max_freq = 6000", "").unwrap(), Some(6000.0));
+        assert_eq!(transfer("transfer_max_freq = 6000", "transfer_max_freq = 0").unwrap(), None);
+        assert_eq!(transfer("", "transfer_max_freq = 12000.5").unwrap(), Some(12000.5));
+        for bad in ["transfer_max_freq = -1", "transfer_max_freq = nan", "transfer_max_freq = inf"] {
+            let e = transfer("", bad).unwrap_err().to_string();
+            assert!(e.contains("`transfer_max_freq`") && e.contains("#1"), "{bad}: {e}");
+        }
+        let e = transfer("", "transfer_max_freq = \"high\"").unwrap_err().to_string();
+        assert!(e.contains("transfer_max_freq"), "{e}");
     }
 
     #[test]

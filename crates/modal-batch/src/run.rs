@@ -2,12 +2,16 @@
 //! content-addressed cache, with a catalogue kept current on disk.
 //!
 //! Per asset: (1) a bank already in the output directory whose
-//! `input_hash` equals the asset's cache key is taken as finished (a killed
-//! run resumes even without a shared cache); (2) otherwise the pipeline runs,
-//! served from the cache when it holds the key (a damaged or torn cache entry
-//! is detected by the bank checksum and recomputed); (3) the bank is written
-//! atomically into the output directory. Any error, even a panic, becomes
-//! the asset's catalogue `status`; the batch goes on.
+//! `input_hash` equals the asset's cache key (and, with `transfer_max_freq`,
+//! which stores that transfer) is taken as finished (a killed run resumes
+//! even without a shared cache); (2) otherwise the pipeline runs, served
+//! from the cache when it holds the key (a damaged or torn cache entry is
+//! detected by the bank checksum and recomputed), and with
+//! `transfer_max_freq` the acoustic transfer of its audible modes is solved
+//! (`modal_radiation::modes::transfer_table`, default air); (3) the bank is
+//! written atomically into the output directory, the transfer stored in it
+//! (format 2). Any error, even a panic, becomes the asset's catalogue
+//! `status`; the batch goes on.
 //!
 //! The catalogue is rewritten atomically after every asset, listing the
 //! assets not finished yet under `pending`, so a killed run leaves an honest
@@ -20,6 +24,8 @@ use std::time::Instant;
 
 use modal_bank::{BankCache, ModeBank};
 use modal_precompute::cache_key;
+use modal_radiation::modes::{audible_modes, is_transfer_table_of, transfer_table};
+use modal_radiation::RadiationOptions;
 
 use crate::{Asset, BatchError, Catalogue, CatalogueEntry, Shard};
 
@@ -132,12 +138,13 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
     });
     let seconds = start.elapsed().as_secs_f64();
     let entry = match outcome {
-        Ok((bank, cached)) => CatalogueEntry {
+        Ok(Solved { bank, transfer_modes, cached }) => CatalogueEntry {
             path: asset.path.clone(),
             bank: Some(asset.bank.clone()),
             hash: Some(bank.info.input_hash.clone()),
             modes: bank.frequencies_hz.len(),
             first_frequency_hz: bank.frequencies_hz.first().copied(),
+            transfer_modes,
             seconds,
             status: "ok".into(),
             cached,
@@ -148,6 +155,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
             hash,
             modes: 0,
             first_frequency_hz: None,
+            transfer_modes: 0,
             seconds,
             status,
             cached: false,
@@ -156,18 +164,40 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
     (entry, warnings)
 }
 
-/// The bank of `asset` and whether it was reused (finished or cached).
+/// An asset's bank as written to the output directory.
+struct Solved {
+    bank: ModeBank,
+    /// Modes with a stored transfer.
+    transfer_modes: usize,
+    /// Reused (finished, or served from the cache with nothing solved).
+    cached: bool,
+}
+
+/// The bank of `asset`, with its transfer when asked, and whether it was
+/// reused (finished or cached).
 fn solve(
     asset: &Asset,
     request: &modal_precompute::Request,
     hash: Option<&str>,
     options: &BatchOptions,
     warnings: &mut Vec<String>,
-) -> Result<(ModeBank, bool), String> {
+) -> Result<Solved, String> {
     let out = options.out_dir.join(&asset.bank);
+    let radiation = RadiationOptions::default();
     if let (Some(hash), false, true) = (hash, options.force, out.exists()) {
-        match ModeBank::load(&out) {
-            Ok(bank) if bank.info.input_hash == hash => return Ok((bank, true)),
+        match ModeBank::load_with_radiation(&out) {
+            Ok((bank, table)) if bank.info.input_hash == hash => {
+                let stored = match (asset.transfer_max_hz, &table) {
+                    (None, _) => Some(table.map_or(0, |t| t.modes.len())),
+                    (Some(f), Some(t)) => {
+                        is_transfer_table_of(t, &bank, f, &radiation).then_some(t.modes.len())
+                    }
+                    (Some(f), None) => audible_modes(&bank, f).is_empty().then_some(0),
+                };
+                if let Some(transfer_modes) = stored {
+                    return Ok(Solved { bank, transfer_modes, cached: true });
+                }
+            }
             Ok(_) => {}
             Err(e) => {
                 warnings.push(format!("{}: replacing the damaged bank {} ({e})", asset.path, out.display()))
@@ -177,11 +207,36 @@ fn solve(
     let outcome = modal_precompute::precompute(request, options.cache.as_ref(), options.force, &mut |_| {})
         .map_err(|e| chain(&e))?;
     warnings.extend(outcome.warnings.iter().map(|w| format!("{}: {w}", asset.path)));
+    let table = match asset.transfer_max_hz {
+        Some(f) => in_pool(options.threads, || transfer_table(&outcome.bank, f, &radiation, &mut |_| {}))?
+            .map_err(|e| format!("acoustic transfer: {}", chain(&e)))?,
+        None => None,
+    };
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
-    outcome.bank.save(&out).map_err(|e| format!("cannot write bank {}: {}", out.display(), chain(&e)))?;
-    Ok((outcome.bank, outcome.cached))
+    let written = match &table {
+        Some(t) => outcome.bank.save_with_radiation(&out, t),
+        None => outcome.bank.save(&out),
+    };
+    written.map_err(|e| format!("cannot write bank {}: {}", out.display(), chain(&e)))?;
+    Ok(Solved {
+        transfer_modes: table.as_ref().map_or(0, |t| t.modes.len()),
+        cached: outcome.cached && table.is_none(),
+        bank: outcome.bank,
+    })
+}
+
+/// `f` on `threads` threads (`None`: rayon's global pool).
+fn in_pool<T: Send>(threads: Option<usize>, f: impl FnOnce() -> T + Send) -> Result<T, String> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| format!("cannot start {n} threads: {e}"))?
+            .install(f)),
+        None => Ok(f()),
+    }
 }
 
 /// An error and its causes, `": "`-separated, each said once.

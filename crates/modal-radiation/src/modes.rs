@@ -284,6 +284,17 @@ fn normal_velocity_with(
         .collect())
 }
 
+/// Lowest damped frequency treated as audible [Hz].
+pub const AUDIBLE_MIN_HZ: f64 = 20.0;
+
+/// Whether mode `mode` of `bank` can be heard below `max_hz`: its damped
+/// frequency at least [`AUDIBLE_MIN_HZ`] and its frequency at most
+/// `max_hz` (the modes `modal radiation` and a batch's stored transfer
+/// solve).
+pub fn is_audible(bank: &ModeBank, mode: usize, max_hz: f64) -> bool {
+    bank.damped_frequency_hz(mode) >= AUDIBLE_MIN_HZ && bank.frequencies_hz[mode] <= max_hz
+}
+
 /// Groups of mode indices (ascending frequency) within `tol` of the group's first.
 pub fn frequency_groups(bank: &ModeBank, modes: &[usize], tol: f64) -> Vec<Vec<usize>> {
     let mut sorted = modes.to_vec();
@@ -627,6 +638,43 @@ pub fn to_table(results: &[ModeRadiation], opts: &RadiationOptions) -> Option<mo
         tolerance: opts.multipole_tolerance,
         modes,
     })
+}
+
+/// The modes a stored transfer up to `max_hz` covers: every
+/// [`is_audible`] mode of `bank`, ascending.
+pub fn audible_modes(bank: &ModeBank, max_hz: f64) -> Vec<usize> {
+    (0..bank.mode_count()).filter(|&i| is_audible(bank, i, max_hz)).collect()
+}
+
+/// The transfer table of every audible mode of `bank` up to `max_hz`
+/// ([`audible_modes`], [`radiate_modes`], [`to_table`]); `None` when no
+/// mode is audible there.
+pub fn transfer_table(
+    bank: &ModeBank,
+    max_hz: f64,
+    opts: &RadiationOptions,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<Option<modal_bank::RadiationTable>, RadiationError> {
+    let modes = audible_modes(bank, max_hz);
+    if modes.is_empty() {
+        return Ok(None);
+    }
+    Ok(to_table(&radiate_modes(bank, &modes, opts, progress)?, opts))
+}
+
+/// Whether `table` is what [`transfer_table`] of `bank` up to `max_hz`
+/// with `opts` stores: the same modes, air and multipole tolerance (a
+/// bank finished earlier need not be solved again).
+pub fn is_transfer_table_of(
+    table: &modal_bank::RadiationTable,
+    bank: &ModeBank,
+    max_hz: f64,
+    opts: &RadiationOptions,
+) -> bool {
+    table.air_density_kg_m3 == opts.air.density_kg_m3
+        && table.sound_speed_m_s == opts.air.sound_speed_m_s
+        && table.tolerance == opts.multipole_tolerance
+        && table.modes.iter().map(|m| m.mode).eq(audible_modes(bank, max_hz))
 }
 
 /// The multipole expansion of a stored entry.
