@@ -503,3 +503,39 @@ fn exactly_tangential_fields_on_the_fem_sphere_radiate_far_below_spheroidal_ones
         assert!(db < GUARD_DB, "{name} at {f} Hz: only {db:.1} dB below the spheroidal fields");
     }
 }
+
+/// `modal precompute --transfer-max-freq F` stores the table `modal
+/// radiation BANK --max-freq F --store` writes for the same bank (every
+/// audible mode up to F), `info --json` shows it, and a bad F is refused
+/// before any solve.
+#[test]
+fn precompute_can_store_the_transfer_of_its_audible_modes() {
+    let dir = temp_dir();
+    let d = dir.path();
+    modal(d, &["mesh", "box", "--size", "0.12,0.06,0.04", "--h", "0.03", "-o", "box.msh"]).ok();
+    let solve = ["precompute", "box.msh", "--material", "steel", "--order", "1", "--modes", "4"];
+    let band = ["--max-freq", "200000", "--no-cache"];
+    let json = modal(
+        d,
+        &[&solve[..], &band, &["-o", "box.bank", "--transfer-max-freq", "20000", "--json"]].concat(),
+    )
+    .ok()
+    .json();
+    let (bank, table) = ModeBank::load_with_radiation(d.join("box.bank")).unwrap();
+    let table = table.expect("--transfer-max-freq stores a table");
+    let audible: Vec<usize> = (0..bank.mode_count()).filter(|&i| bank.frequencies_hz[i] <= 20000.0).collect();
+    assert!(!audible.is_empty() && audible.len() < bank.mode_count(), "{:?}", bank.frequencies_hz);
+    assert_eq!(table.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), audible);
+    for (i, m) in json["modes"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(m["radiated_power_w"].is_null(), !audible.contains(&i), "mode {i}: {m}");
+    }
+    modal(d, &["radiation", "box.bank", "--max-freq", "20000", "--store", "cli.bank"]).ok();
+    let (_, via_cli) = ModeBank::load_with_radiation(d.join("cli.bank")).unwrap();
+    assert_eq!(via_cli.as_ref(), Some(&table), "precompute's table differs from `modal radiation --store`");
+
+    for bad in ["0", "-5", "nan"] {
+        modal(d, &[&solve[..], &band, &["-o", "bad.bank", "--transfer-max-freq", bad]].concat())
+            .fails_with("--transfer-max-freq");
+        assert!(!d.join("bad.bank").exists());
+    }
+}

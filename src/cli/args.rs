@@ -245,6 +245,10 @@ pub struct PrecomputeArgs {
     /// The --accuracy target applies to the lowest N modes (all modes get an estimate).
     #[arg(long, value_name = "N", default_value_t = 10)]
     pub accuracy_modes: usize,
+    /// Also solve each audible mode's acoustic transfer up to HZ and store it in the bank
+    /// (format 2), as `modal radiation BANK --max-freq HZ --store` does (default air).
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
+    pub transfer_max_freq: Option<f64>,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,

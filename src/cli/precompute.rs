@@ -78,6 +78,12 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
         .accuracy
         .0
         .map(|target_pct| modal_precompute::AccuracyTarget { target_pct, modes: args.accuracy_modes });
+    if let Some(f) = args.transfer_max_freq {
+        anyhow::ensure!(
+            f.is_finite() && f > 0.0,
+            "--transfer-max-freq must be a positive frequency in Hz, got {f}"
+        );
+    }
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
     let spinner = Spinner::new("starting");
     let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| {
@@ -86,9 +92,17 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     spinner.finish();
     let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;
     outcome.warnings.iter().for_each(|w| warn(w));
-    interrupt::guarded(|| outcome.bank.save(&args.out))
-        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
-    let report = BankJson::new(&outcome.bank, outcome.cached);
+    let table = match args.transfer_max_freq {
+        Some(f) => transfer(&outcome.bank, f)?,
+        None => None,
+    };
+    let bank = &outcome.bank;
+    interrupt::guarded(|| match &table {
+        Some(t) => bank.save_with_radiation(&args.out, t),
+        None => bank.save(&args.out),
+    })
+    .with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    let report = BankJson::new(bank, outcome.cached).with_radiation(table.as_ref());
     if args.json {
         print_json(&report)
     } else {
@@ -96,6 +110,19 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
         println!("wrote {}", args.out.display());
         Ok(())
     }
+}
+
+/// The transfer table of `bank`'s audible modes up to `max_hz`
+/// (`--transfer-max-freq`), with progress on stderr; `None` (and a warning)
+/// when no mode is audible there.
+fn transfer(bank: &modal_bank::ModeBank, max_hz: f64) -> Result<Option<modal_bank::RadiationTable>> {
+    let opts = modal_radiation::RadiationOptions::default();
+    let table = modal_radiation::modes::transfer_table(bank, max_hz, &opts, &mut |p| eprintln!("{p}"))
+        .context("acoustic transfer (--transfer-max-freq)")?;
+    if table.is_none() {
+        warn(&format!("no audible mode at or below {max_hz} Hz: the bank stores no transfer"));
+    }
+    Ok(table)
 }
 
 pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
