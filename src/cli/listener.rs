@@ -9,7 +9,13 @@
 //! divided by [`FULL_SCALE_PA`], the full scale of `render` at gain 1.
 //!
 //! The transfer comes from, in order of preference:
-//! 1. the bank's stored radiation table (`modal radiation --store`),
+//! 1. the bank's stored radiation table (`modal radiation --store`); its
+//!    multipole expansion is only valid beyond the fit radius `r_f` (and
+//!    diverges inside it), so a listener at `r < r_f` from the centre of
+//!    mass hears, as in `render`, the field at `r_f` in its direction
+//!    spread back by `r_f / max(r, r_min)` (`r_min` = `MIN_DISTANCE_M`; at
+//!    the centre itself, where no direction is defined, the
+//!    direction-averaged level);
 //! 2. a boundary-element solve now (`--solve-radiation`),
 //! 3. the level estimate `render` uses without radiation (a pulsating
 //!    sphere with the object's area and the mode's RMS normal velocity,
@@ -63,7 +69,9 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
         let r = distance(x, table.centre_m);
         if r < table.fit_radius_m {
             warn(&format!(
-                "the listener is {r:.3} m from the centre of mass, inside the {:.3} m radius the stored far field is accurate beyond",
+                "the listener is {r:.3} m from the centre of mass, inside the {:.3} m radius the stored far field \
+                 is accurate beyond: it hears the field at that radius spread back to it, as `render` does \
+                 (--solve-radiation for the near field)",
                 table.fit_radius_m
             ));
         }
@@ -71,7 +79,7 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
             match table.mode(i) {
                 Some(entry) => {
                     let mp = modal_radiation::modes::stored_multipole(&table, entry);
-                    gains[i] = mp.pressure_at(x).norm() / FULL_SCALE_PA;
+                    gains[i] = held_level(&mp, x) / FULL_SCALE_PA;
                 }
                 None => {
                     gains[i] = estimate[i];
@@ -116,6 +124,26 @@ pub fn stored_radiation(path: &Path) -> Result<Option<modal_bank::RadiationTable
     Ok(table)
 }
 
+/// `|p|` [Pa] of the stored expansion `mp` heard at `x` (module doc):
+/// `|P(x)|` beyond the fit radius, the fit sphere's field spread back by
+/// `r_f / max(r, r_min)` inside it, the direction-averaged level at the
+/// centre.
+fn held_level(mp: &modal_radiation::Multipole, x: [f64; 3]) -> f64 {
+    let r = distance(x, mp.centre);
+    if r >= mp.fit_radius {
+        return mp.pressure_at(x).norm();
+    }
+    let spread = mp.fit_radius / r.max(MIN_DISTANCE_M);
+    if r == 0.0 {
+        let mean_square: f64 =
+            mp.coefficients.iter().map(|a| a.norm_sqr()).sum::<f64>() / (4.0 * std::f64::consts::PI);
+        // √(mean |F|²) / r_f: the far-field level at the fit radius.
+        return mean_square.sqrt() / mp.wavenumber / mp.fit_radius * spread;
+    }
+    let on_sphere = [0, 1, 2].map(|q| mp.centre[q] + (x[q] - mp.centre[q]) * mp.fit_radius / r);
+    mp.pressure_at(on_sphere).norm() * spread
+}
+
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
@@ -135,4 +163,52 @@ fn estimate_gains(bank: &ModeBank, x: [f64; 3]) -> Result<Vec<f64>> {
             AIR_IMPEDANCE_PA_S_M * (a / r) * ka / (1.0 + ka * ka).sqrt() * v / FULL_SCALE_PA
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use modal_radiation::{c64, Multipole};
+
+    /// A degree-2 expansion about `centre` fitted at 0.3 m.
+    fn expansion(centre: [f64; 3]) -> Multipole {
+        let coefficients = (0..9).map(|j| c64::new(0.3 * j as f64 - 1.0, 0.1 * (j % 4) as f64)).collect();
+        Multipole { centre, wavenumber: 20.0, fit_radius: 0.3, order: 2, coefficients }
+    }
+
+    #[test]
+    fn a_listener_inside_the_fit_radius_hears_the_fit_sphere_spread_back() {
+        let c = [0.1, -0.2, 0.05];
+        let mp = expansion(c);
+        let at = |dir: [f64; 3], r: f64| held_level(&mp, [0, 1, 2].map(|q| c[q] + dir[q] * r));
+        let dir = [0.6, 0.0, 0.8];
+        // Beyond the fit radius: the expansion itself.
+        let far = [0, 1, 2].map(|q| c[q] + dir[q] * 0.7);
+        assert_eq!(held_level(&mp, far), mp.pressure_at(far).norm());
+        // Continuous at the fit radius, then 1/r inwards, held below r_min.
+        let on = at(dir, 0.3);
+        assert!((at(dir, 0.3 * (1.0 - 1e-12)) - on).abs() < 1e-9 * on);
+        assert!((at(dir, 0.15) - 2.0 * on).abs() < 1e-12 * on);
+        let held = on * 0.3 / MIN_DISTANCE_M;
+        for r in [0.05, 1e-3, 1e-9] {
+            // (At 1 nm the direction keeps ~8 digits of the offset from c.)
+            assert!((at(dir, r) - held).abs() < 1e-6 * held, "r = {r}");
+        }
+        // The expansion itself diverges there; the held level does not.
+        assert!(mp.pressure_at([0, 1, 2].map(|q| c[q] + dir[q] * 1e-3)).norm() > 1e3 * held);
+        // At the centre: the direction-averaged level at the fit radius, spread back.
+        let mean: f64 = (0..400)
+            .map(|i| {
+                // Fibonacci directions.
+                let z = 1.0 - (2.0 * i as f64 + 1.0) / 400.0;
+                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                let s = (1.0 - z * z).sqrt();
+                mp.far_field([s * phi.cos(), s * phi.sin(), z]).norm_sqr()
+            })
+            .sum::<f64>()
+            / 400.0;
+        let centre = held_level(&mp, c);
+        let want = mean.sqrt() / 0.3 * 0.3 / MIN_DISTANCE_M;
+        assert!(centre.is_finite() && (centre - want).abs() < 0.01 * want, "{centre} vs {want}");
+    }
 }
