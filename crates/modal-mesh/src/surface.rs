@@ -1,5 +1,12 @@
 //! Boundary surface of a tet mesh: the faces that belong to exactly one tet.
 //!
+//! Faces are matched by their corner nodes, and then once more by their
+//! corners' positions: two boundary faces on the same three points (a
+//! mesher's cut points computed twice, a hair's breadth apart) are the two
+//! sides of an internal crack, not surface. Kept, they put panels of
+//! opposite normals at zero distance, where a boundary-element solve's
+//! kernels blow up (a glass mug's handle root gave matrix entries of 10³⁷).
+//!
 //! For a positively oriented tet `[0, 1, 2, 3]` the faces
 //! `[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]` (opposite corners 0..3) have
 //! counter-clockwise corners seen from outside, i.e. the normal
@@ -20,7 +27,83 @@ fn edge_slot(a: usize, b: usize) -> usize {
     4 + e.expect("corners of a tet edge")
 }
 
-/// The boundary surface of `mesh` (faces used by exactly one tet), outward
+/// Nodes closer than this times the bounding-box diagonal are one point
+/// when matching boundary faces (module doc).
+pub const COINCIDENT_NODE_TOLERANCE: f64 = 1e-10;
+
+/// Clears `on_boundary` (indexed `4·tet + face`) for every boundary face
+/// that shares its three corner positions, within
+/// [`COINCIDENT_NODE_TOLERANCE`], with another boundary face.
+fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
+    let ids: Vec<usize> = (0..on_boundary.len()).filter(|&id| on_boundary[id]).collect();
+    let corners = |id: usize| TET_FACES[id % 4].map(|k| mesh.cells.corners(id / 4)[k]);
+    let mut nodes: Vec<usize> = ids.iter().flat_map(|&id| corners(id)).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let point = |n: usize| mesh.nodes[n];
+    let (lo, hi) = nodes.iter().fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), &n| {
+        let p = point(n);
+        ([0, 1, 2].map(|k| lo[k].min(p[k])), [0, 1, 2].map(|k| hi[k].max(p[k])))
+    });
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let tol = COINCIDENT_NODE_TOLERANCE * diagonal;
+    if !(tol > 0.0 && tol.is_finite()) {
+        return;
+    }
+    // Each node's representative: the first node (in index order) within
+    // `tol`, found in the 27 grid cells of side `tol` around it.
+    let cell = |p: [f64; 3]| p.map(|x| (x / tol).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    let mut representative = vec![usize::MAX; mesh.nodes.len()];
+    let mut merged = false;
+    for &n in &nodes {
+        let (p, c) = (point(n), cell(point(n)));
+        let mut found = None;
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &m in grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]).into_iter().flatten() {
+                        let d = sub(point(m), p);
+                        if dot(d, d) <= tol * tol {
+                            found = Some(m);
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        match found {
+            Some(m) => {
+                representative[n] = representative[m];
+                merged = true;
+            }
+            None => {
+                representative[n] = n;
+                grid.entry(c).or_default().push(n);
+            }
+        }
+    }
+    if !merged {
+        return;
+    }
+    let mut keyed: Vec<([usize; 3], usize)> = ids
+        .iter()
+        .map(|&id| {
+            let mut key = corners(id).map(|n| representative[n]);
+            key.sort_unstable();
+            (key, id)
+        })
+        .collect();
+    keyed.sort_unstable();
+    for run in keyed.chunk_by(|a, b| a.0 == b.0).filter(|run| run.len() > 1) {
+        for &(_, id) in run {
+            on_boundary[id] = false;
+        }
+    }
+}
+
+/// The boundary surface of `mesh` (faces used by exactly one tet, less the
+/// coincident pairs of the module doc), outward
 /// oriented if the tets are positively oriented (run [`crate::check`] first),
 /// with local node numbering in order of first use. For 10-node meshes the
 /// mid-edge nodes of each triangle's edges (0,1), (1,2), (2,0) are included.
@@ -45,6 +128,7 @@ pub fn boundary_surface(mesh: &TetMesh) -> Surface {
             on_boundary[*id] = true;
         }
     }
+    drop_coincident_faces(mesh, &mut on_boundary);
     let quadratic = matches!(mesh.cells, Cells::Tet10(_));
     let mut local = vec![usize::MAX; mesh.nodes.len()];
     let mut surface = Surface::default();

@@ -186,6 +186,31 @@ fn two_tets(apex: [f64; 3]) -> TetMesh {
     }
 }
 
+/// The two tets of [`two_tets`] with the shared face's corner 3 given to
+/// the second tet as a separate node `offset` away (a crack).
+fn cracked_tets(offset: f64) -> TetMesh {
+    let mut mesh = two_tets([1.0, 1.0, 1.0]);
+    mesh.nodes.push([0.0, offset, 1.0]);
+    mesh.cells = Cells::Tet4(vec![[0, 1, 2, 3], [4, 1, 5, 2]]);
+    mesh
+}
+
+#[test]
+fn coincident_boundary_faces_are_an_internal_crack_not_surface() {
+    // Intact: 6 faces; cracked by a hair (the mesher's cut point computed
+    // twice): the shared face's two copies are dropped, not kept as two
+    // opposite panels at zero distance.
+    let intact = boundary_surface(&two_tets([1.0, 1.0, 1.0]));
+    assert_eq!(intact.triangles.len(), 6);
+    let hair = boundary_surface(&cracked_tets(5.9e-19));
+    assert_eq!(hair.triangles.len(), 6);
+    assert!((hair.area() - intact.area()).abs() < 1e-15);
+    // ∮ x·n = 3V of the union: the surface is still closed around both tets.
+    assert!((flux_of_position(&hair) - 1.5).abs() < 1e-15, "{}", flux_of_position(&hair));
+    // A real gap (1e-6 of the size) is surface: 8 faces.
+    assert_eq!(boundary_surface(&cracked_tets(1e-6)).triangles.len(), 8);
+}
+
 #[test]
 fn tets_on_opposite_sides_of_a_shared_face_pass() {
     let (_, report) = check(two_tets([1.0, 1.0, 1.0])).unwrap();

@@ -38,8 +38,10 @@ pub use pipeline::{
 /// block solves run on the factor repacked into row tiles (`modal-eigen` `tiled`); 4 — the
 /// Cholesky factorization of large factors runs in parallel (two tasks); 5 — Gram–Schmidt
 /// products of the Krylov blocks on a row-major copy (`modal-eigen` `cgs`); 6 — our own
-/// two-core numeric Cholesky for factors below 40 M entries (`modal-eigen` `supernodal`).
-pub const SOLVER_VERSION: &str = "modal-precompute-6";
+/// two-core numeric Cholesky for factors below 40 M entries (`modal-eigen` `supernodal`); 7 —
+/// the bank's surface leaves out coincident boundary faces, an internal crack
+/// (`modal_mesh::boundary_surface`).
+pub const SOLVER_VERSION: &str = "modal-precompute-7";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]
