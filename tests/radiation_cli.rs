@@ -188,6 +188,16 @@ fn points_inside_the_body_and_bad_air_are_clear_errors() {
     modal(dir.path(), &["radiation", "sphere.bank", "--point", "0.01,0,0"]).fails_with("inside the body");
     modal(dir.path(), &["radiation", "sphere.bank", "--point", "1,0,0", "--sound-speed", "0"])
         .fails_with("sound speed");
+    // Absurd but positive air is refused at once, not solved for minutes.
+    for (flag, value) in [("--sound-speed", "1"), ("--sound-speed", "1e9"), ("--air-density", "1e200")] {
+        let run = modal(dir.path(), &["radiation", "sphere.bank", "--point", "1,0,0", flag, value]);
+        let run = run.fails_with("gases and liquids");
+        assert!(
+            !run.stderr.contains("mode(s) on"),
+            "{flag} {value}: refused only after starting\n{}",
+            run.stderr
+        );
+    }
     let bad = modal(dir.path(), &["radiation", "sphere.bank", "--point", "1,0"]);
     assert!(
         !bad.success && bad.stderr.contains("X,Y,Z") && !bad.stderr.contains("panicked"),

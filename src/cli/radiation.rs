@@ -113,8 +113,14 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     for &m in &args.mode {
         ensure!(m < bank.mode_count(), "mode {m} does not exist (the bank has {} modes)", bank.mode_count());
     }
-    let candidates: Vec<usize> =
+    if let Some(path) = &args.store {
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        ensure!(dir.is_dir(), "--store {}: directory {} does not exist", path.display(), dir.display());
+    }
+    let mut candidates: Vec<usize> =
         if args.mode.is_empty() { (0..bank.mode_count()).collect() } else { args.mode.clone() };
+    candidates.sort_unstable();
+    candidates.dedup();
     let (modes, skipped): (Vec<usize>, Vec<usize>) = candidates.into_iter().partition(|&i| audible(i));
     eprintln!(
         "radiation: {} mode(s) on {} panels ({} skipped as inaudible)",
@@ -122,6 +128,13 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         mesh.len(),
         skipped.len()
     );
+    if modes.is_empty() {
+        super::output::warn(&format!(
+            "no audible mode to solve (none at {} Hz or more and at most --max-freq {} Hz)",
+            modal_radiation::modes::AUDIBLE_MIN_HZ,
+            args.max_freq
+        ));
+    }
     let opts = RadiationOptions {
         air,
         adaptive_resolution: !args.full_resolution,

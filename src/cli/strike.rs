@@ -163,6 +163,15 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     if rendered.capped {
         warn(&format!("the sound rings longer than {AUTO_DURATION_CAP_S} s: faded out at the cap"));
     }
+    let stats = &rendered.stats;
+    if stats.modes_total > 0 && stats.modes_skipped == stats.modes_total {
+        super::output::warn(&format!(
+            "all {} modes were skipped (below 20 Hz, above 0.45 × --rate {} Hz, or overdamped): {} is silent",
+            stats.modes_total,
+            args.rate,
+            args.out.display()
+        ));
+    }
     let json = StrikeJson {
         out: args.out.display().to_string(),
         output,

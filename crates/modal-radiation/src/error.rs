@@ -29,8 +29,17 @@ pub enum RadiationError {
     /// A frequency is not finite and positive.
     #[error("frequency {0} Hz is not finite and positive")]
     BadFrequency(f64),
-    /// Air density or sound speed is not finite and positive.
-    #[error("air density {density} kg/m³ and sound speed {speed} m/s must be finite and positive")]
+    /// Air density or sound speed is not finite or outside the ranges of
+    /// gases and liquids ([`crate::bem::DENSITY_RANGE_KG_M3`],
+    /// [`crate::bem::SOUND_SPEED_RANGE_M_S`]).
+    #[error(
+        "air density {density} kg/m³ and sound speed {speed} m/s must lie within {} – {} kg/m³ and {} – {} m/s \
+         (gases and liquids)",
+        crate::bem::DENSITY_RANGE_KG_M3.0,
+        crate::bem::DENSITY_RANGE_KG_M3.1,
+        crate::bem::SOUND_SPEED_RANGE_M_S.0,
+        crate::bem::SOUND_SPEED_RANGE_M_S.1
+    )]
     BadAir {
         /// Density [kg/m³].
         density: f64,
