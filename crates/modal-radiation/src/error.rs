@@ -63,7 +63,7 @@ pub enum RadiationError {
         mode: usize,
     },
     /// A field point lies inside the vibrating body.
-    #[error("point ({x}, {y}, {z}) lies inside the body: pressure is only defined outside it")]
+    #[error("point ({x:?}, {y:?}, {z:?}) lies inside the body: pressure is only defined outside it")]
     PointInsideBody {
         /// x [m].
         x: f64,
@@ -76,7 +76,7 @@ pub enum RadiationError {
     /// representation formula is accurate
     /// ([`crate::geometry::ON_SURFACE_RATIO`]).
     #[error(
-        "point ({x}, {y}, {z}) lies on the body's surface ({} m from it): pressure is evaluated only \
+        "point ({x:?}, {y:?}, {z:?}) lies on the body's surface ({} m from it): pressure is evaluated only \
          in the air; move the point at least {} m away from the surface",
         metres(*.distance_m),
         metres(*.tolerance_m)
@@ -93,9 +93,12 @@ pub enum RadiationError {
         /// Distance the point must keep from the surface [m].
         tolerance_m: f64,
     },
-    /// A field point so far away that the kernels' `r²` would overflow
-    /// ([`crate::geometry::MAX_FIELD_COORDINATE_M`]).
-    #[error("point ({x:e}, {y:e}, {z:e}) m is out of range: each coordinate must be within ±{max_m:e} m (farther, r² overflows)")]
+    /// A field point so far away that f64 distances no longer resolve the
+    /// body ([`crate::geometry::MAX_FIELD_COORDINATE_M`]).
+    #[error(
+        "point ({x:?}, {y:?}, {z:?}) m is out of range: each coordinate must be within ±{max_m:e} m (farther, \
+         the distances lose the body's size to rounding; the far field is p·r = const)"
+    )]
     PointOutOfRange {
         /// x [m].
         x: f64,

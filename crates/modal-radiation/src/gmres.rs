@@ -232,7 +232,9 @@ impl<'a> Recurrence<'a> {
     /// A new Krylov cycle from the residual `r`, or the end.
     fn start_cycle(&mut self) {
         let beta = norm(&self.r);
-        let stalled = !(beta < MIN_CYCLE_REDUCTION * self.cycle_start);
+        // A NaN residual stalls too.
+        let lowered = beta < MIN_CYCLE_REDUCTION * self.cycle_start;
+        let stalled = !lowered;
         if beta <= TOLERANCE * self.bnorm || self.iterations >= MAX_ITERATIONS || stalled {
             self.finish();
             return;

@@ -36,7 +36,7 @@ pub enum SynthError {
     InvalidPoint([f64; 3]),
     /// A query point farther from the surface than 10 % of the bounding-box diagonal.
     #[error(
-        "point [{}, {}, {}] m is {distance:.4} m from the surface (limit {limit:.4} m = 10 % of the bounding-box diagonal)",
+        "point [{:?}, {:?}, {:?}] m is {distance:.4} m from the surface (limit {limit:.4} m = 10 % of the bounding-box diagonal)",
         point[0], point[1], point[2]
     )]
     PointFarFromSurface {
