@@ -102,6 +102,7 @@ pub(crate) fn repair(surface: &TriSurface) -> Repaired {
     let flips = orient(&vertices, &mut triangles, &mut report);
     report.flipped_faces = flips;
     report.warnings.extend(unit_warning(report.diagonal_m));
+    report.warnings.extend(open_warning(report.open_boundary_edges));
     Repaired { vertices, triangles, report }
 }
 
@@ -227,6 +228,20 @@ fn signed_volume(vertices: &[V3], triangles: &[[usize; 3]], component: &[usize],
 }
 
 /// A warning when the size suggests the file is not in metres.
+/// An open surface (holes, a sheet without thickness) is meshed as the
+/// solid its winding number encloses: a hole is capped, an open shell is
+/// filled. Said, because that may not be the object the user meant (an
+/// open hemisphere of zero thickness became an 8 kg half-ball).
+fn open_warning(open_edges: usize) -> Option<String> {
+    (open_edges > 0).then(|| {
+        format!(
+            "the surface is open ({open_edges} edges belong to one triangle only): it is meshed as the solid its \
+             winding number encloses, so holes are capped and an open shell is filled; close the surface, or give \
+             a sheet its thickness, if that is not the object"
+        )
+    })
+}
+
 fn unit_warning(diagonal: f64) -> Option<String> {
     if diagonal > 20.0 {
         Some(format!(

@@ -104,6 +104,13 @@ fn robust_small_hole_gives_nearly_the_clean_volume() {
     holed.triangles.drain(0..6);
     let report = modal_tetra::diagnose(&holed);
     assert!(report.open_boundary_edges > 0);
+    // Said, since capping a hole (or filling an open shell) may not be the object meant.
+    assert!(
+        report.warnings.iter().any(|w| w.contains("open") && w.contains("capped")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(!modal_tetra::diagnose(&sphere()).warnings.iter().any(|w| w.contains("open")));
     let r = mesh(&holed);
     assert!(rel(r.volume_m3, clean.volume_m3).abs() < 0.01, "{r:?} vs {clean:?}");
 }
