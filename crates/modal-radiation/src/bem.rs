@@ -256,6 +256,32 @@ pub struct Discretization<'a> {
     pub aggregate: bool,
 }
 
+/// How a system was solved (for progress reports: a fallback is slow).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverPath {
+    /// GMRES on the compressed matrix ([`crate::hmatrix`]), with its
+    /// iterations (the largest over the right-hand sides).
+    CompressedGmres(usize),
+    /// GMRES on the dense matrix, with its iterations.
+    DenseGmres(usize),
+    /// Dense LU; `after_gmres`: GMRES was tried first and did not converge.
+    Lu {
+        /// GMRES failed before it.
+        after_gmres: bool,
+    },
+}
+
+impl std::fmt::Display for SolverPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SolverPath::CompressedGmres(it) => write!(f, "compressed GMRES, {it} iterations"),
+            SolverPath::DenseGmres(it) => write!(f, "dense GMRES, {it} iterations"),
+            SolverPath::Lu { after_gmres: false } => write!(f, "dense LU"),
+            SolverPath::Lu { after_gmres: true } => write!(f, "dense LU after GMRES did not converge"),
+        }
+    }
+}
+
 /// [`solve_clustered`] on a prepared [`Discretization`].
 pub fn solve_on(
     disc: &Discretization<'_>,
@@ -264,6 +290,17 @@ pub fn solve_on(
     velocities: &[Vec<c64>],
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
+    solve_on_reported(disc, air, frequency_hz, velocities, formulation).map(|(fields, _)| fields)
+}
+
+/// [`solve_on`], also saying how the system was solved.
+pub fn solve_on_reported(
+    disc: &Discretization<'_>,
+    air: Air,
+    frequency_hz: f64,
+    velocities: &[Vec<c64>],
+    formulation: Formulation,
+) -> Result<(Vec<SurfaceField>, SolverPath), RadiationError> {
     let (mesh, clusters) = (disc.mesh, disc.clusters);
     if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
         return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
@@ -289,17 +326,22 @@ pub fn solve_on(
     let q: Vec<Vec<c64>> = velocities.iter().map(|v| v.iter().map(|z| z * iwr).collect()).collect();
     let kern = Kernels::new(k);
     let asm = Assembly::new(mesh, disc.near, clusters, &kern, alpha, &q, disc.aggregate);
-    let pressures = if clusters.len() >= HMATRIX_MIN_UNKNOWNS { compressed_solve(&asm) } else { None }
+    let compressed = clusters.len() >= HMATRIX_MIN_UNKNOWNS;
+    let (pressures, path) = if compressed { compressed_solve(&asm) } else { None }
+        .map(|(p, it)| (p, SolverPath::CompressedGmres(it)))
         .or_else(|| {
             if clusters.len() > MAX_DENSE_UNKNOWNS {
                 return None;
             }
             let (mut at, mut rhs) = assemble_dense(&asm);
-            iterative_solve(&asm, &at, &rhs)
-                .or_else(|| lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs))
+            let iterative = clusters.len() >= ITERATIVE_MIN_UNKNOWNS;
+            iterative_solve(&asm, &at, &rhs).map(|(p, it)| (p, SolverPath::DenseGmres(it))).or_else(|| {
+                lu_solve_transposed(&mut at, clusters.len(), &mut rhs, nrhs)
+                    .map(|p| (p, SolverPath::Lu { after_gmres: compressed || iterative }))
+            })
         })
         .ok_or(RadiationError::Singular { frequency_hz })?;
-    Ok((0..nrhs)
+    let fields = (0..nrhs)
         .map(|f| SurfaceField {
             frequency_hz,
             wavenumber: k,
@@ -307,7 +349,8 @@ pub fn solve_on(
             pressure: clusters.of_panel.iter().map(|&c| pressures[(c, f)]).collect(),
             normal_velocity: velocities[f].clone(),
         })
-        .collect())
+        .collect();
+    Ok((fields, path))
 }
 
 /// Systems with at least this many unknowns are solved by GMRES
@@ -338,7 +381,7 @@ pub const MAX_DENSE_UNKNOWNS: usize = 6000;
 /// all fields at once), preconditioned by the diagonal blocks of the
 /// cluster tree's leaves ([`crate::precond`]); `None` when a block is
 /// singular or any field does not converge.
-fn compressed_solve(asm: &Assembly<'_>) -> Option<Mat<c64>> {
+fn compressed_solve(asm: &Assembly<'_>) -> Option<(Mat<c64>, usize)> {
     let (h, rhs) = HMatrix::assemble(asm);
     let pc = BlockJacobi::new(asm.len(), h.diagonal_blocks().map(|(u, d)| (u, d.to_vec())))?;
     gmres_solve(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| h.apply_many(xs, ys), &rhs, asm.fields().len())
@@ -349,7 +392,7 @@ fn compressed_solve(asm: &Assembly<'_>) -> Option<Mat<c64>> {
 /// the leaves of the cluster tree of `asm` ([`HMatrix::leaves`]); `None`
 /// below [`ITERATIVE_MIN_UNKNOWNS`] or when any field does not converge
 /// (the caller then factorises).
-fn iterative_solve(asm: &Assembly<'_>, a: &[c64], rhs: &[c64]) -> Option<Mat<c64>> {
+fn iterative_solve(asm: &Assembly<'_>, a: &[c64], rhs: &[c64]) -> Option<(Mat<c64>, usize)> {
     let n = asm.len();
     if n < ITERATIVE_MIN_UNKNOWNS {
         return None;
@@ -366,18 +409,19 @@ fn iterative_solve(asm: &Assembly<'_>, a: &[c64], rhs: &[c64]) -> Option<Mat<c64
 }
 
 /// [`crate::gmres::solve_many`] on the right-hand sides `rhs` (row-major
-/// `n × nrhs`); the solutions as columns.
+/// `n × nrhs`); the solutions as columns, and the most iterations any took.
 fn gmres_solve(
     pc: &BlockJacobi,
     apply: &crate::gmres::MultiProduct<'_>,
     rhs: &[c64],
     nrhs: usize,
-) -> Option<Mat<c64>> {
+) -> Option<(Mat<c64>, usize)> {
     let n = pc.len();
     let bs: Vec<Vec<c64>> = (0..nrhs).map(|f| (0..n).map(|i| rhs[i * nrhs + f]).collect()).collect();
     let bs: Vec<&[c64]> = bs.iter().map(Vec::as_slice).collect();
     let solutions = crate::gmres::solve_many(pc, apply, &bs)?;
-    Some(Mat::from_fn(n, nrhs, |i, f| solutions[f].x[i]))
+    let iterations = solutions.iter().map(|s| s.iterations).max().unwrap_or(0);
+    Some((Mat::from_fn(n, nrhs, |i, f| solutions[f].x[i]), iterations))
 }
 
 /// Solves `A x = b` given `at = Aᵀ` (column-major `n × n`, overwritten by
@@ -488,6 +532,32 @@ mod tests {
         ));
     }
 
+    /// `solve_on_reported` names the path each size takes.
+    #[test]
+    fn the_report_names_how_each_system_was_solved() {
+        let air = Air::default();
+        let path = |subdivisions: u32| {
+            let mesh = crate::geometry::tests::ellipsoid([0.1, 0.07, 0.05], subdivisions);
+            let vel: Vec<c64> = mesh.panels.iter().map(|p| c64::new(p.normal[0], 0.0)).collect();
+            let (near, clusters) = (NearField::new(&mesh), Clusters::identity(mesh.len()));
+            let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate: true };
+            let (fields, path) =
+                solve_on_reported(&disc, air, 1000.0, std::slice::from_ref(&vel), Formulation::BurtonMiller)
+                    .unwrap();
+            assert_eq!(fields.len(), 1);
+            (mesh.len(), path)
+        };
+        let (n, small) = path(2);
+        assert!(
+            n < ITERATIVE_MIN_UNKNOWNS && small == SolverPath::Lu { after_gmres: false },
+            "{n}: {small:?}"
+        );
+        let (n, large) = path(3);
+        assert!((ITERATIVE_MIN_UNKNOWNS..HMATRIX_MIN_UNKNOWNS).contains(&n), "{n}");
+        assert!(matches!(large, SolverPath::DenseGmres(it) if it > 0), "{large:?}");
+        assert_eq!(SolverPath::Lu { after_gmres: true }.to_string(), "dense LU after GMRES did not converge");
+    }
+
     #[test]
     fn gmres_and_lu_agree_on_a_burton_miller_system() {
         // 1280 panels (above ITERATIVE_MIN_UNKNOWNS), an ellipsoid, ka ≈ 2.
@@ -505,7 +575,8 @@ mod tests {
         let asm = Assembly::new(&mesh, &near, &clusters, &kern, alpha, &fields, true);
         let (mut at, mut rhs) =
             crate::assembly::assemble(&mesh, &near, &clusters, &kern, alpha, &fields, true);
-        let it = iterative_solve(&asm, &at, &rhs).expect("GMRES converges");
+        let (it, iterations) = iterative_solve(&asm, &at, &rhs).expect("GMRES converges");
+        assert!(iterations > 0 && iterations < n, "{iterations} iterations");
         let lu = lu_solve_transposed(&mut at, n, &mut rhs, 1).unwrap();
         let diff: f64 = (0..n).map(|i| (it[(i, 0)] - lu[(i, 0)]).norm_sqr()).sum::<f64>().sqrt();
         let size: f64 = (0..n).map(|i| lu[(i, 0)].norm_sqr()).sum::<f64>().sqrt();
@@ -524,8 +595,9 @@ mod tests {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| compressed_solve(&asm).expect("GMRES converges"))
         };
-        let it = on(1);
-        assert!(it == on(3), "thread count changed the compressed solve");
+        let (it, iterations) = on(1);
+        assert!(iterations > 0);
+        assert!((it.clone(), iterations) == on(3), "thread count changed the compressed solve");
         let n = asm.len();
         let (mut at, mut rhs) = assemble_dense(&asm);
         let lu = lu_solve_transposed(&mut at, n, &mut rhs, 2).unwrap();

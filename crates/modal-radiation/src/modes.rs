@@ -18,7 +18,7 @@ use std::time::Instant;
 use faer::c64;
 use modal_bank::ModeBank;
 
-use crate::bem::{solve_on, Air, Discretization, Formulation, SurfaceField};
+use crate::bem::{solve_on_reported, Air, Discretization, Formulation, SolverPath, SurfaceField};
 use crate::cluster::{Adjacency, Clusters};
 use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
@@ -128,13 +128,15 @@ pub struct Progress {
     pub near_bytes: usize,
     /// Seconds spent in the multipole fit.
     pub fit_s: f64,
+    /// How the system was solved (a dense LU after GMRES failed is slow).
+    pub solver: SolverPath,
 }
 
 impl std::fmt::Display for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s{}, fit {:.2} s",
+            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s{} [{}], fit {:.2} s",
             self.groups_done,
             self.groups,
             self.modes,
@@ -148,6 +150,7 @@ impl std::fmt::Display for Progress {
             } else {
                 String::new()
             },
+            self.solver,
             self.fit_s
         )
     }
@@ -579,7 +582,7 @@ pub fn radiate_modes_on(
         let near_s = if fresh { t0.elapsed().as_secs_f64() } else { 0.0 };
         let disc =
             Discretization { mesh, near, clusters: &plan.clusters, aggregate: opts.adaptive_resolution };
-        let surfaces = solve_on(&disc, opts.air, f, &fields, opts.formulation)?;
+        let (surfaces, solver) = solve_on_reported(&disc, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
@@ -609,6 +612,7 @@ pub fn radiate_modes_on(
             near_s,
             near_bytes: near.bytes(),
             fit_s,
+            solver,
         });
     }
     Ok(out)
