@@ -58,9 +58,7 @@ pub struct ListenerGains {
 pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) -> Result<ListenerGains> {
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
     super::radiation::check_field_points(bank, &mesh, &[x]).context("--listener")?;
-    let audible: Vec<usize> = (0..bank.mode_count())
-        .filter(|&i| bank.damped_frequency_hz(i) >= modal_radiation::modes::AUDIBLE_MIN_HZ)
-        .collect();
+    let audible = modal_radiation::modes::audible_modes(bank, f64::INFINITY);
     let table = stored_radiation(path)?;
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
