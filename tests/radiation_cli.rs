@@ -382,6 +382,30 @@ fn strike_hears_the_listener_by_default_linearly_and_audibly() {
 }
 
 #[test]
+fn strikes_default_listener_stands_back_from_a_large_body() {
+    // A 0.6 m sphere: 0.5 m off its surface is inside the 1.2 m sphere a
+    // stored far field is accurate beyond, so the default listener stands on it.
+    let dir = temp_dir();
+    modal(dir.path(), &["mesh", "sphere", "--radius", "0.6", "--h", "0.3", "-o", "big.msh"]).ok();
+    modal(
+        dir.path(),
+        &["precompute", "big.msh", "-o", "big.bank", "--modes", "2", "--no-cache", "--material", "steel"],
+    )
+    .ok();
+    let run = modal(
+        dir.path(),
+        &["strike", "big.bank", "--at", "0.6,0,0", "--duration", "0.05", "-o", "b.wav", "--json"],
+    )
+    .ok();
+    let l: Vec<f64> =
+        run.json()["output"]["listener_m"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let r = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+    assert!((r - 1.2).abs() < 0.012, "listener {l:?} at {r} m from the centre, not on the fit sphere");
+    // Along the struck facet's normal (a coarse sphere's facet: near radial), beyond 0.5 m.
+    assert!(l[0] > 1.1 && l[0] / r > 0.95, "not off the struck point: {l:?}");
+}
+
+#[test]
 fn coarse_panels_at_low_frequency_agree_with_the_full_resolution() {
     // A 10× softer sphere: its modes near 500 Hz (ka ≈ 0.5) are solved on the
     // corner triangles (a quarter of the panels) unless --full-resolution.

@@ -346,7 +346,8 @@ pub struct StrikeArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub mic: Option<[f64; 3]>,
     /// Listener position X,Y,Z [m] in the bank's frame: output the pressure there (full scale 20 Pa).
-    /// Default: 0.5 m from the first struck point along its outward normal.
+    /// Default: 0.5 m from the first struck point along its outward normal, farther along it for a large
+    /// body (to 2 bounding radii from the centre of mass, where the stored far field is accurate).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, conflicts_with = "mic")]
     pub listener: Option<[f64; 3]>,
     /// Solve the radiation now when the bank has none stored (slow; see `modal radiation --store`).

@@ -34,6 +34,36 @@ use super::output::warn;
 /// Default listener distance from the first struck point, along its outward normal [m].
 pub const DEFAULT_LISTENER_DISTANCE_M: f64 = 0.5;
 
+/// `strike`'s default listener: [`DEFAULT_LISTENER_DISTANCE_M`] off the
+/// first struck point `surface_point` along its outward `normal`, or, for a
+/// body too large for that (bounding radius above ≈ 0.25 m), farther along
+/// the same line until it reaches the sphere beyond which a stored far
+/// field is accurate ([`modal_radiation::multipole::FIT_RADIUS_PER_BODY_RADIUS`]
+/// bounding radii from the centre of mass). So the default hears the whole
+/// body as a listener in the room would, never an expansion inside its fit
+/// radius.
+pub fn default_listener(bank: &ModeBank, surface_point: [f64; 3], normal: [f64; 3]) -> Result<[f64; 3]> {
+    let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
+    let centre = bank.mass.center_of_mass_m;
+    let fit_radius = modal_radiation::multipole::FIT_RADIUS_PER_BODY_RADIUS * mesh.radius_about(centre);
+    Ok(beyond_sphere(surface_point, normal, centre, fit_radius, DEFAULT_LISTENER_DISTANCE_M))
+}
+
+/// The point `start + t·n̂` with the smallest `t ≥ min_distance` at which
+/// `|x − centre| ≥ radius`: `t = −d·n̂ + √((d·n̂)² − |d|² + radius²)`,
+/// `d = start − centre`, when that exceeds `min_distance` (`start` lies
+/// inside the sphere, so the root is real and positive).
+fn beyond_sphere(start: [f64; 3], n: [f64; 3], centre: [f64; 3], radius: f64, min_distance: f64) -> [f64; 3] {
+    let length = distance(n, [0.0; 3]);
+    let n = if length > 0.0 { n.map(|c| c / length) } else { [0.0, 0.0, 1.0] };
+    let d = [0, 1, 2].map(|q| start[q] - centre[q]);
+    let dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    let discriminant = dn * dn - (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + radius * radius;
+    let exit = if discriminant > 0.0 { -dn + discriminant.sqrt() } else { 0.0 };
+    let t = exit.max(min_distance);
+    [0, 1, 2].map(|q| start[q] + t * n[q])
+}
+
 /// Where the per-mode transfer came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -172,6 +202,26 @@ mod tests {
     fn expansion(centre: [f64; 3]) -> Multipole {
         let coefficients = (0..9).map(|j| c64::new(0.3 * j as f64 - 1.0, 0.1 * (j % 4) as f64)).collect();
         Multipole { centre, wavenumber: 20.0, fit_radius: 0.3, order: 2, coefficients }
+    }
+
+    #[test]
+    fn the_default_listener_is_half_a_metre_off_or_on_the_fit_sphere_if_farther() {
+        let c = [0.2, -0.1, 0.3];
+        let start = [0.25, -0.1, 0.3];
+        let n = [0.0, 0.0, 2.0]; // not unit: the direction counts
+                                 // A small body: 0.5 m along the normal.
+        let near = beyond_sphere(start, n, c, 0.3, 0.5);
+        assert_eq!(near, [0.25, -0.1, 0.8]);
+        // A large one: on the fit sphere, along the same line, beyond 0.5 m.
+        for radius in [1.0, 3.0, 40.0] {
+            let x = beyond_sphere(start, n, c, radius, 0.5);
+            assert!((distance(x, c) - radius).abs() <= 1e-12 * radius, "radius {radius}: {x:?}");
+            assert_eq!([x[0], x[1]], [start[0], start[1]]);
+            assert!(x[2] - start[2] > 0.5);
+        }
+        // A normal pointing back past the centre still leaves the sphere.
+        let x = beyond_sphere(start, [-1.0, 0.0, 0.0], c, 2.0, 0.5);
+        assert!((distance(x, c) - 2.0).abs() <= 1e-12 && x[0] < c[0]);
     }
 
     #[test]

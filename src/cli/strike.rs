@@ -1,5 +1,6 @@
 //! `modal strike`: strike a bank at surface points and write the sound: the
-//! pressure at a listener (default 0.5 m off the first struck point, see
+//! pressure at a listener (default 0.5 m off the first struck point, farther
+//! for bodies larger than ≈ 0.25 m in radius, see
 //! [`super::listener`]) or, with `--mic`, a contact microphone.
 
 use anyhow::{bail, ensure, Context, Result};
@@ -13,7 +14,7 @@ use serde::Serialize;
 use super::args::StrikeArgs;
 use super::bank_cmds::load_bank;
 use super::interrupt;
-use super::listener::{listener_gains, TransferSource, DEFAULT_LISTENER_DISTANCE_M};
+use super::listener::{default_listener, listener_gains, TransferSource};
 use super::output::{print_json, warn};
 
 /// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
@@ -128,11 +129,14 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             OutputJson { kind: "contact_mic", listener_m: None, transfer: None },
         ),
         None => {
-            let listener = args.listener.unwrap_or_else(|| {
-                let p = &points_json[0];
-                let n = model.locate(p.surface_point).map(|h| h.normal).unwrap_or([0.0, 0.0, 1.0]);
-                [0, 1, 2].map(|c| p.surface_point[c] + DEFAULT_LISTENER_DISTANCE_M * n[c])
-            });
+            let listener = match args.listener {
+                Some(x) => x,
+                None => {
+                    let p = &points_json[0];
+                    let n = model.locate(p.surface_point).map(|h| h.normal).unwrap_or([0.0, 0.0, 1.0]);
+                    default_listener(&bank, p.surface_point, n)?
+                }
+            };
             let heard = listener_gains(&args.bank, &bank, listener, args.solve_radiation)?;
             (
                 OutputGain::PerMode(heard.gains),

@@ -109,6 +109,10 @@ impl Multipole {
     }
 }
 
+/// The fit radius in body radii (the largest distance of a surface node
+/// from the expansion centre): the truncation error is stated there.
+pub const FIT_RADIUS_PER_BODY_RADIUS: f64 = 2.0;
+
 /// Multipole expansions about `centre` of solutions that share one
 /// wavenumber, by exact projection, truncated to relative RMS error `tol`
 /// at twice the body radius (see the module doc). The work is split in
@@ -119,7 +123,7 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
     let Some(first) = fields.first() else { return Vec::new() };
     let k = first.wavenumber;
     let radius = mesh.radius_about(centre);
-    let fit_radius = 2.0 * radius;
+    let fit_radius = FIT_RADIUS_PER_BODY_RADIUS * radius;
     let cap = (k * radius).ceil() as usize + EXTRA_DEGREES;
     let ncoef = (cap + 1) * (cap + 1);
     let delta = 1e-4 * (1.0 / k).min(radius);
