@@ -163,10 +163,8 @@ fn held_level(mp: &modal_radiation::Multipole, x: [f64; 3]) -> f64 {
     }
     let spread = mp.fit_radius / r.max(MIN_DISTANCE_M);
     if r == 0.0 {
-        let mean_square: f64 =
-            mp.coefficients.iter().map(|a| a.norm_sqr()).sum::<f64>() / (4.0 * std::f64::consts::PI);
-        // √(mean |F|²) / r_f: the far-field level at the fit radius.
-        return mean_square.sqrt() / mp.wavenumber / mp.fit_radius * spread;
+        // The far-field level at the fit radius, RMS over directions.
+        return mp.far_field_rms() / mp.fit_radius * spread;
     }
     let on_sphere = [0, 1, 2].map(|q| mp.centre[q] + (x[q] - mp.centre[q]) * mp.fit_radius / r);
     mp.pressure_at(on_sphere).norm() * spread

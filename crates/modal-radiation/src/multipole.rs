@@ -74,6 +74,14 @@ impl Multipole {
         p
     }
 
+    /// RMS of the far-field pattern over all directions [Pa·m]:
+    /// `√(Σ|a_lm|²/4π)/k`, since `|h_l(kr)| → 1/(kr)` and the `Y_l^m` are
+    /// orthonormal on the unit sphere.
+    pub fn far_field_rms(&self) -> f64 {
+        let sum: f64 = self.coefficients.iter().map(|a| a.norm_sqr()).sum();
+        (sum / (4.0 * std::f64::consts::PI)).sqrt() / self.wavenumber
+    }
+
     /// Far-field pattern `F(d̂)` with `p ≈ F e^{ikr}/r` [Pa·m].
     pub fn far_field(&self, direction: [f64; 3]) -> c64 {
         let y = spherical_harmonics(self.order, direction);
@@ -204,4 +212,38 @@ pub fn fit(mesh: &BoundaryMesh, fields: &[SurfaceField], centre: [f64; 3], tol: 
             Multipole { centre, wavenumber: k, fit_radius, order, coefficients }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `far_field_rms` is the RMS of `far_field` over the sphere (Fibonacci
+    /// directions), and `far_field` is `r·e^{−ikr}·p` far away.
+    #[test]
+    fn far_field_rms_is_the_pattern_averaged_over_directions() {
+        let order = 3;
+        let coefficients = (0..(order + 1) * (order + 1))
+            .map(|j| c64::new((j as f64 * 0.7).sin(), 0.2 * j as f64 - 1.0))
+            .collect();
+        let mp =
+            Multipole { centre: [0.1, 0.0, -0.2], wavenumber: 15.0, fit_radius: 0.4, order, coefficients };
+        let n = 4000;
+        let mean_square: f64 = (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                let s = (1.0 - z * z).sqrt();
+                mp.far_field([s * phi.cos(), s * phi.sin(), z]).norm_sqr()
+            })
+            .sum::<f64>()
+            / n as f64;
+        let rms = mp.far_field_rms();
+        assert!((mean_square.sqrt() - rms).abs() < 1e-3 * rms, "{} vs {rms}", mean_square.sqrt());
+        let (d, r) = ([0.6, 0.0, 0.8], 1e4);
+        let x = [0, 1, 2].map(|q| mp.centre[q] + d[q] * r);
+        let phase = c64::new(0.0, -mp.wavenumber * r).exp();
+        let far = mp.pressure_at(x) * r * phase;
+        assert!((far - mp.far_field(d)).norm() < 1e-3 * mp.far_field(d).norm());
+    }
 }

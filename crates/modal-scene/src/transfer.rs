@@ -110,8 +110,7 @@ impl BankTransfer {
                 continue;
             }
             let k = entry.wavenumber;
-            let sum2: f64 = entry.coefficients.iter().map(|c| c[0] * c[0] + c[1] * c[1]).sum();
-            let g = (sum2 / (4.0 * std::f64::consts::PI)).sqrt() / k;
+            let g = modal_radiation::modes::stored_multipole(table, entry).far_field_rms();
             gains[entry.mode] = g;
             with_transfer += 1;
             levels.push(ModeLevel {
