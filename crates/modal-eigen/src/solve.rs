@@ -591,7 +591,9 @@ fn spectrum_scale(
 }
 
 /// 75 % of MemAvailable from /proc/meminfo.
-fn default_memory_limit() -> Option<u64> {
+/// The solver's default memory limit: 75 % of the available memory
+/// (`MemAvailable` in `/proc/meminfo`), `None` where that is unknown.
+pub fn default_memory_limit() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;

@@ -27,6 +27,13 @@ use crate::{FemError, Material};
 /// Elements whose matrices are computed in one parallel batch.
 const CHUNK: usize = 1024;
 
+/// Bytes that K, M (each its own row indices and values) and the shared
+/// pattern hold for `nnz` stored entries and `dofs` columns: 8-byte indices
+/// and values, so `5·8·nnz` plus the column pointers.
+pub fn matrices_bytes(nnz: u64, dofs: u64) -> u64 {
+    5 * 8 * nnz + 3 * 8 * (dofs + 1)
+}
+
 /// Assembled global stiffness `k` \[N/m\] and consistent mass `m` \[kg\], both
 /// `3·nodes × 3·nodes`, full symmetric storage, same sparsity pattern.
 #[derive(Clone, Debug)]
@@ -52,6 +59,15 @@ impl SparsityPattern {
     /// Builds the pattern of `mesh`. Fails on an empty mesh or a node index
     /// out of range.
     pub fn new(mesh: &TetMesh) -> Result<SparsityPattern, FemError> {
+        Self::new_within(mesh, None)
+    }
+
+    /// [`SparsityPattern::new`], refused with [`FemError::TooLarge`] before
+    /// the pattern is built when K, M and the pattern would hold more than
+    /// `limit_bytes` ([`matrices_bytes`]): the node adjacency alone (a
+    /// ninth of the pattern's entries) tells, so an absurd mesh fails in
+    /// seconds instead of exhausting memory in assembly.
+    pub fn new_within(mesh: &TetMesh, limit_bytes: Option<u64>) -> Result<SparsityPattern, FemError> {
         let n_nodes = mesh.node_count();
         let n_el = mesh.cells.len();
         if n_el == 0 {
@@ -64,6 +80,10 @@ impl SparsityPattern {
         }
         let (adj_ptr, adj) = node_adjacency(mesh);
         let n_dof = 3 * n_nodes;
+        let needed_bytes = matrices_bytes(9 * adj.len() as u64, n_dof as u64);
+        if let Some(limit_bytes) = limit_bytes.filter(|&l| needed_bytes > l) {
+            return Err(FemError::TooLarge { dofs: n_dof, needed_bytes, limit_bytes });
+        }
         let mut col_ptr = Vec::with_capacity(n_dof + 1);
         let mut row_idx = Vec::with_capacity(9 * adj.len());
         col_ptr.push(0);

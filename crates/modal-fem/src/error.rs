@@ -46,4 +46,19 @@ pub enum FemError {
     /// A node-indexed array or part index that does not fit the mesh.
     #[error("{0}")]
     InvalidArgument(String),
+    /// The assembled matrices alone would not fit the memory limit.
+    #[error(
+        "the mesh has {dofs} DOF: its stiffness and mass matrices alone would need ≈ {:.1} GB, above the memory \
+         limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
+        *needed_bytes as f64 / 1e9,
+        *limit_bytes as f64 / 1e9
+    )]
+    TooLarge {
+        /// Degrees of freedom.
+        dofs: usize,
+        /// Bytes K, M and their pattern would hold.
+        needed_bytes: u64,
+        /// The limit [bytes].
+        limit_bytes: u64,
+    },
 }

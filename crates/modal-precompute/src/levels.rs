@@ -204,7 +204,7 @@ pub(crate) fn solve_to_accuracy(
             ));
             return Ok((bank, warnings));
         }
-        let guard = request.memory_limit_bytes.or_else(memory_guard_bytes);
+        let guard = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
         let next = NextLevel { memory: fine.memory, seconds: fine.seconds, spent, step };
         if let Some(stop) = next.refused(refinement, guard) {
             let cell = fine.cell_m * step;
@@ -340,14 +340,6 @@ fn trim(bank: &ModeBank, request: &Request, est: Option<&LevelEstimate>) -> (Mod
         out.info.error_estimate_pct = kept.error_pct.clone();
     }
     (out, kept)
-}
-
-/// 75 % of MemAvailable (the eigensolver's default memory limit), if known.
-fn memory_guard_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024 / 4 * 3)
 }
 
 #[cfg(test)]

@@ -185,7 +185,9 @@ pub(crate) fn assemble_and_analyze(
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
     progress(Stage::Assemble { dofs: 3 * mesh.nodes.len() });
     let start = Instant::now();
-    let pattern = modal_fem::SparsityPattern::new(&mesh)?;
+    // Refuse before assembly what the solver's memory guard would refuse after it.
+    let limit = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
+    let pattern = modal_fem::SparsityPattern::new_within(&mesh, limit)?;
     let (assembly, analysis) = if analyze && request.fix_box.is_none() {
         // A failed analysis is not an error here: the solve redoes it and reports.
         let (assembly, analysis) = rayon::join(
