@@ -171,3 +171,19 @@ fn generated_meshes_are_written_and_read_back() {
     modal(dir.path(), &["mesh", "sphere", "--radius", "-1", "-o", "bad.msh"]).fails_with("radius");
     assert!(!dir.path().join("bad.msh").exists());
 }
+
+#[test]
+fn a_mesh_beyond_the_memory_guard_is_refused_before_assembly() {
+    // 1 MB: less than the bar's stiffness and mass matrices alone.
+    let dir = temp_dir();
+    let bar = example("bar_p1.msh");
+    let limit = std::path::Path::new("0.001");
+    let run = modal_with_env(
+        dir.path(),
+        &["precompute", bar.to_str().unwrap(), "-o", "a.bank", "--no-cache", "--material", "steel"],
+        &[("MODAL_MEMORY_LIMIT_GB", limit)],
+    );
+    let text = run.fails_with("stiffness and mass matrices alone would need").stderr;
+    assert!(text.contains("DOF") && text.contains("coarser mesh"), "{text}");
+    assert!(!dir.path().join("a.bank").exists(), "no output on failure");
+}

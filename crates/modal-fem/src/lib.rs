@@ -23,7 +23,7 @@ mod material;
 pub mod quadrature;
 mod rigid;
 
-pub use assembly::{assemble, prepare_mesh, Assembly, SparsityPattern, DEFAULT_ORDER};
+pub use assembly::{assemble, matrices_bytes, prepare_mesh, Assembly, SparsityPattern, DEFAULT_ORDER};
 pub use constraints::{fix_box, restrict, DofMap, Restricted};
 pub use error::FemError;
 pub use export::{write_matrix_market, write_nodes_csv};

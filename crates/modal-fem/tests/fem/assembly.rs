@@ -168,3 +168,23 @@ fn matrix_market_is_lower_triangle_one_based_full_precision() {
         .collect();
     assert_eq!(parsed, mesh.nodes);
 }
+
+#[test]
+fn a_pattern_beyond_the_memory_limit_is_refused_with_what_it_would_need() {
+    let mesh = small_mesh(2);
+    let full = SparsityPattern::new(&mesh).unwrap();
+    let needed = modal_fem::matrices_bytes(full.nnz() as u64, full.dof_count() as u64);
+    // K and M: values and row indices each, plus the shared pattern, 8 bytes an entry.
+    assert!(needed >= 5 * 8 * full.nnz() as u64);
+    assert!(SparsityPattern::new_within(&mesh, Some(needed)).is_ok(), "exactly at the limit fits");
+    match SparsityPattern::new_within(&mesh, Some(needed - 1)) {
+        Err(e @ modal_fem::FemError::TooLarge { .. }) => {
+            let text = e.to_string();
+            assert!(
+                text.contains(&format!("{} DOF", full.dof_count())) && text.contains("coarser mesh"),
+                "{text}"
+            );
+        }
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+}
