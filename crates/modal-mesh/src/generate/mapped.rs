@@ -58,6 +58,11 @@ pub(crate) fn tet_count(cells: [usize; 3]) -> u64 {
     cells.iter().fold(6u64, |acc, &n| acc.saturating_mul(n as u64))
 }
 
+/// Tets of all `blocks`, saturating.
+pub(crate) fn total_tets(blocks: &[Block<'_>]) -> u64 {
+    blocks.iter().fold(0u64, |acc, b| acc.saturating_add(tet_count(b.cells)))
+}
+
 /// Errors unless `order` is 1 or 2.
 pub(crate) fn check_order(order: u8) -> Result<(), MeshError> {
     if order == 1 || order == 2 {
@@ -71,7 +76,7 @@ impl BlockMesh<'_> {
     /// Builds the mesh at element order 1 or 2.
     pub fn build(&self, order: u8) -> Result<TetMesh, MeshError> {
         check_order(order)?;
-        let total = self.blocks.iter().fold(0u64, |acc, b| acc.saturating_add(tet_count(b.cells)));
+        let total = total_tets(&self.blocks);
         check_count(total)?;
         let template = oriented_template();
         let mut param: Vec<[f64; 3]> = Vec::new();

@@ -20,7 +20,8 @@
 
 use std::f64::consts::PI;
 
-use super::mapped::{linspace, mid, ogrid, positive, smaller, Block, BlockMesh};
+use super::mapped::{self, linspace, mid, ogrid, positive, smaller, total_tets, Block, BlockMesh};
+use super::Shape;
 use crate::{MeshError, TetMesh};
 
 /// Half-size of the O-grid's core box in q-space (the unit ball has radius 1).
@@ -139,9 +140,7 @@ pub fn tube(inner: f64, outer: f64, length: f64, h: f64, order: u8) -> Result<Te
     positive("length", length)?;
     positive("h", h)?;
     smaller("inner_radius", inner, "outer_radius", outer)?;
-    let around = cells_for(PI * (inner + outer), h).max(8);
-    let radii = linspace(inner, outer, cells_for(outer - inner, h));
-    let zs = linspace(0.0, length, cells_for(length, h));
+    let (around, radii, zs) = tube_grid(inner, outer, length, h);
     let (radii, zs) = (&radii, &zs);
     let block = Block {
         cells: [around, zs.len() - 1, radii.len() - 1],
@@ -164,6 +163,41 @@ pub fn tube(inner: f64, outer: f64, length: f64, h: f64, order: u8) -> Result<Te
     mesh.build(order)
 }
 
+/// The tube's cells around, and its radii and heights of grid lines.
+fn tube_grid(inner: f64, outer: f64, length: f64, h: f64) -> (usize, Vec<f64>, Vec<f64>) {
+    let around = cells_for(PI * (inner + outer), h).max(8);
+    (around, linspace(inner, outer, cells_for(outer - inner, h)), linspace(0.0, length, cells_for(length, h)))
+}
+
+/// The bowl's O-grid (its disk radius 1 maps to the arc π R_mid / 2 from
+/// bottom to rim) and its levels through the wall.
+fn bowl_grid(radius: f64, thickness: f64, h: f64) -> (OGrid, Vec<f64>) {
+    (OGrid::new(0.5 * PI * (radius - 0.5 * thickness), h), linspace(0.0, 1.0, cells_for(thickness, h)))
+}
+
+/// Tets the generator makes for `shape` at element size `h` (the same cell
+/// counts, no mesh built; saturating).
+pub(crate) fn tet_count(shape: &Shape, h: f64) -> u64 {
+    match *shape {
+        Shape::Box { size } => mapped::tet_count(size.map(|s| cells_for(s, h))),
+        Shape::Cylinder { radius, length } => {
+            let zs = linspace(0.0, length, cells_for(length, h));
+            let blocks = OGrid::new(radius, h).disk_blocks(&zs);
+            total_tets(&blocks)
+        }
+        Shape::Tube { inner_radius, outer_radius, length } => {
+            let (around, radii, zs) = tube_grid(inner_radius, outer_radius, length, h);
+            mapped::tet_count([around, zs.len() - 1, radii.len() - 1])
+        }
+        Shape::Sphere { radius } => total_tets(&OGrid::new(radius, h).ball_blocks()),
+        Shape::Bowl { radius, thickness } => {
+            let (grid, ws) = bowl_grid(radius, thickness, h);
+            let blocks = grid.disk_blocks(&ws);
+            total_tets(&blocks)
+        }
+    }
+}
+
 /// Solid ball of `radius` (m) centred at the origin.
 pub fn sphere(radius: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
     positive("radius", radius)?;
@@ -182,9 +216,7 @@ pub fn bowl(radius: f64, thickness: f64, h: f64, order: u8) -> Result<TetMesh, M
     positive("h", h)?;
     smaller("thickness", thickness, "the radius", radius)?;
     let inner = radius - thickness;
-    // The disk's radius 1 maps to the arc π R_mid / 2 from bottom to rim.
-    let grid = OGrid::new(0.5 * PI * (radius - 0.5 * thickness), h);
-    let ws = linspace(0.0, 1.0, cells_for(thickness, h));
+    let (grid, ws) = bowl_grid(radius, thickness, h);
     let map = |q: [f64; 3]| {
         let d = ogrid([q[0], q[1]], CORE);
         let rho = d[0].hypot(d[1]);
