@@ -42,7 +42,12 @@ fn identical_assets_are_solved_once_and_both_sound() {
         "--radiation",
         "estimate",
     ];
-    let first = modal(dir.path(), &args).ok().json();
+    let first = modal(dir.path(), &args).ok();
+    // A log (stderr not a terminal) still says which bank is being solved and what it took.
+    let solving: Vec<&str> = first.stderr.lines().filter(|l| l.starts_with("mode bank for")).collect();
+    assert_eq!(solving.len(), 2, "{}", first.stderr);
+    assert!(solving[0].contains("DOF once") && solving[1].contains(" s"), "{solving:?}");
+    let first = first.json();
     assert_eq!(first["banks_requested"], 1);
     assert_eq!(first["banks_solved"], 1);
     assert_eq!(first["clipped_samples"], 0);
@@ -57,7 +62,9 @@ fn identical_assets_are_solved_once_and_both_sound() {
     let wav = std::fs::read(dir.path().join("s.wav")).unwrap();
 
     // Second run: banks come from the cache and the WAV is bit-identical.
-    let second = modal(dir.path(), &args).ok().json();
+    let second = modal(dir.path(), &args).ok();
+    assert!(!second.stderr.contains("mode bank for"), "a cached bank is not announced: {}", second.stderr);
+    let second = second.json();
     assert_eq!(second["banks_cached"], 1);
     assert_eq!(std::fs::read(dir.path().join("s.wav")).unwrap(), wav);
 

@@ -79,8 +79,30 @@ impl BankProvider for PipelineProvider<'_> {
         };
         let pipeline = self.request(request, material, source);
         self.spinner.set(format!("mode bank for {what}"));
-        let outcome = modal_precompute::precompute(&pipeline, self.cache.as_ref(), false, &mut |_| {})
-            .map_err(|e| format!("{what}: {e}"))?;
+        // A solve can take minutes: say so on stderr (also in a log, where
+        // the spinner is hidden) when the first level is assembled, i.e.
+        // only when the bank is not cached.
+        let spinner = self.spinner;
+        let started = std::time::Instant::now();
+        let mut announced = false;
+        let outcome = modal_precompute::precompute(&pipeline, self.cache.as_ref(), false, &mut |stage| {
+            if let modal_precompute::Stage::Assemble { dofs } = stage {
+                if !announced {
+                    spinner
+                        .note(&format!("mode bank for {what}: solving {dofs} DOF once (cached afterwards)"));
+                    announced = true;
+                }
+                spinner.set(format!("mode bank for {what}: {dofs} DOF"));
+            }
+        })
+        .map_err(|e| format!("{what}: {e}"))?;
+        if announced {
+            spinner.note(&format!(
+                "mode bank for {what}: {} mode(s) in {:.1} s",
+                outcome.bank.mode_count(),
+                started.elapsed().as_secs_f64()
+            ));
+        }
         self.warnings.extend(outcome.warnings.into_iter().map(|w| format!("{what}: {w}")));
         if outcome.cached {
             self.cached += 1;
