@@ -392,11 +392,14 @@ fn strikes_default_listener_stands_back_from_a_large_body() {
         &["precompute", "big.msh", "-o", "big.bank", "--modes", "2", "--no-cache", "--material", "steel"],
     )
     .ok();
+    modal(dir.path(), &["radiation", "big.bank", "--store", "rad.bank"]).ok();
     let run = modal(
         dir.path(),
-        &["strike", "big.bank", "--at", "0.6,0,0", "--duration", "0.05", "-o", "b.wav", "--json"],
+        &["strike", "rad.bank", "--at", "0.6,0,0", "--duration", "0.05", "-o", "b.wav", "--json"],
     )
     .ok();
+    assert!(!run.stderr.contains("inside the"), "the default is not inside the fit sphere: {}", run.stderr);
+    assert_eq!(run.json()["output"]["transfer"], "stored");
     let l: Vec<f64> =
         run.json()["output"]["listener_m"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
     let r = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();

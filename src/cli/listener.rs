@@ -46,7 +46,9 @@ pub fn default_listener(bank: &ModeBank, surface_point: [f64; 3], normal: [f64; 
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
     let centre = bank.mass.center_of_mass_m;
     let fit_radius = modal_radiation::multipole::FIT_RADIUS_PER_BODY_RADIUS * mesh.radius_about(centre);
-    Ok(beyond_sphere(surface_point, normal, centre, fit_radius, DEFAULT_LISTENER_DISTANCE_M))
+    // A hair outside, so rounding never puts it inside (and warns).
+    let radius = fit_radius * (1.0 + 1e-9);
+    Ok(beyond_sphere(surface_point, normal, centre, radius, DEFAULT_LISTENER_DISTANCE_M))
 }
 
 /// The point `start + t·n̂` with the smallest `t ≥ min_distance` at which
