@@ -136,6 +136,21 @@ fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
 }
 
 #[test]
+fn a_thin_plates_default_size_is_reported_and_within_the_budget() {
+    // 15 × 10 cm, 4 mm: D_min/2 would give 45 000 tets; the budget ≈ 12 000.
+    let dir = temp_dir();
+    let written = modal(
+        dir.path(),
+        &["mesh", "box", "--size", "0.15,0.004,0.1", "--order", "2", "-o", "p.msh", "--json"],
+    )
+    .ok()
+    .json();
+    let h = written["element_size_m"].as_f64().unwrap();
+    assert!(h > 0.002 && h < 0.0075, "h = {h}");
+    assert!(written["tets"].as_u64().unwrap() <= 12_000, "{written}");
+}
+
+#[test]
 fn generated_meshes_are_written_and_read_back() {
     let dir = temp_dir();
     let shapes: [&[&str]; 5] = [
@@ -151,6 +166,8 @@ fn generated_meshes_are_written_and_read_back() {
         args.extend(["-o", "shape.msh", "--json"]);
         let written = modal(dir.path(), &args).ok().json();
         assert!(written["tets"].as_u64().unwrap() > 0);
+        let h: f64 = shape[shape.iter().position(|&a| a == "--h").unwrap() + 1].parse().unwrap();
+        assert_eq!(written["element_size_m"].as_f64(), Some(h), "the size used is reported");
         let mut solve = vec![
             "precompute",
             "shape.msh",

@@ -81,16 +81,18 @@ fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
         "nodes": mesh.nodes.len(),
         "tets": mesh.cells.len(),
         "order": mesh.order(),
+        "element_size_m": h,
     });
     if args.json {
         print_json(&summary)
     } else {
         println!(
-            "wrote {} ({} nodes, {} tets, order {})",
+            "wrote {} ({} nodes, {} tets, order {}, element size {:.4} m)",
             args.out.display(),
             mesh.nodes.len(),
             mesh.cells.len(),
-            mesh.order()
+            mesh.order(),
+            h
         );
         Ok(())
     }
