@@ -22,7 +22,13 @@ fn json_contract_cache_and_info_agree() {
     let dir = temp_dir();
     let mut flags = STEEL.to_vec();
     flags.extend(["--alpha", "5", "--beta", "3e-8"]);
-    let first = precompute(dir.path(), "a.bank", &flags);
+    let bar = example("bar_p1.msh");
+    let mut args = vec!["precompute", bar.to_str().unwrap(), "-o", "a.bank", "--modes", "8", "--json"];
+    args.extend(&flags);
+    let run = modal(dir.path(), &args).ok();
+    // In a log (stderr is not a terminal) the long stages are lines.
+    assert!(run.stderr.contains("precompute: assembling K and M ("), "{}", run.stderr);
+    let first = run.json();
     for key in
         ["modes", "dofs", "order", "mass_kg", "rigid_modes_removed", "inertia_check", "cached", "timings_s"]
     {

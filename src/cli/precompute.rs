@@ -86,8 +86,11 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     }
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
     let spinner = Spinner::new("starting");
-    let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| {
-        spinner.set(describe(&s))
+    let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| match s {
+        Stage::Assemble { .. } | Stage::Level { .. } => {
+            spinner.milestone(format!("precompute: {}", describe(&s)))
+        }
+        _ => spinner.set(describe(&s)),
     });
     spinner.finish();
     let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;

@@ -27,6 +27,17 @@ impl Spinner {
         self.bar.set_message(message.into());
     }
 
+    /// Replaces the message and, when stderr is not a terminal (a log,
+    /// where the spinner is hidden), also prints it as a line: a stage that
+    /// may take minutes stays visible there.
+    pub fn milestone(&self, message: impl Into<String>) {
+        let message = message.into();
+        if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+            self.bar.suspend(|| eprintln!("{message}"));
+        }
+        self.bar.set_message(message);
+    }
+
     /// Prints a line on stderr above the spinner (progress that should
     /// stay visible, also when stderr is not a terminal).
     pub fn note(&self, line: &str) {
