@@ -142,7 +142,7 @@ fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
 }
 
 #[test]
-fn a_thin_plates_default_size_is_reported_and_within_the_budget() {
+fn thin_plates_and_long_tubes_get_default_sizes_within_the_budget_and_report_them() {
     // 15 × 10 cm, 4 mm: D_min/2 would give 45 000 tets; the budget ≈ 12 000.
     let dir = temp_dir();
     let written = modal(
@@ -154,6 +154,28 @@ fn a_thin_plates_default_size_is_reported_and_within_the_budget() {
     let h = written["element_size_m"].as_f64().unwrap();
     assert!(h > 0.002 && h < 0.0075, "h = {h}");
     assert!(written["tets"].as_u64().unwrap() <= 12_000, "{written}");
+    assert_eq!(written["axial_element_size_m"].as_f64(), Some(h), "a box is uniform");
+    // A 1 m chime tube, 1.5 mm wall: twice the wall around, longer along the axis.
+    let args = [
+        "mesh",
+        "tube",
+        "--inner-radius",
+        "0.0235",
+        "--outer-radius",
+        "0.025",
+        "--length",
+        "1",
+        "--order",
+        "2",
+        "-o",
+        "c.msh",
+        "--json",
+    ];
+    let chime = modal(dir.path(), &args).ok().json();
+    let (h, axial) =
+        (chime["element_size_m"].as_f64().unwrap(), chime["axial_element_size_m"].as_f64().unwrap());
+    assert!((h - 0.003).abs() < 1e-9 && axial > 0.02, "{chime}");
+    assert!(chime["tets"].as_u64().unwrap() <= 12_000, "{chime}");
 }
 
 #[test]

@@ -172,7 +172,8 @@ pub enum MeshShape {
 #[derive(Debug, Args)]
 pub struct GenerateArgs {
     /// Target element size [m] (default at order 2: min(D_min/2, D_max/4), coarsened for thin plates and
-    /// bowls to about 12 000 tets; at order 1: min(D_min/8, D_max/20); docs/scene-format.md).
+    /// bowls, and along long tubes, to about 12 000 tets; at order 1: min(D_min/8, D_max/20);
+    /// docs/scene-format.md). A given size is used in every direction.
     #[arg(long, value_name = "H", allow_negative_numbers = true)]
     pub h: Option<f64>,
     /// Element order of the written mesh (2 puts curved mid-edge nodes on curved surfaces).

@@ -1,7 +1,7 @@
 //! `modal mesh …`: generate a tet mesh, or tetrahedralize a surface mesh.
 
 use anyhow::{Context, Result};
-use modal_mesh::generate::Shape;
+use modal_mesh::generate::{ElementSizes, Shape};
 use modal_mesh::TetMesh;
 
 use super::args::{GenerateArgs, MeshShape};
@@ -73,8 +73,9 @@ pub fn run(shape: MeshShape) -> Result<()> {
 }
 
 fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
-    let h = args.h.unwrap_or_else(|| shape.default_element_size(args.order));
-    let mesh = modal_mesh::generate::generate(&shape, h, args.order)?;
+    let sizes = args.h.map_or_else(|| shape.default_sizes(args.order), ElementSizes::uniform);
+    let h = sizes.h;
+    let mesh = modal_mesh::generate::generate_sized(&shape, sizes, args.order)?;
     write_mesh(&args.out, &mesh)?;
     let summary = serde_json::json!({
         "out": args.out.display().to_string(),
@@ -82,6 +83,7 @@ fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
         "tets": mesh.cells.len(),
         "order": mesh.order(),
         "element_size_m": h,
+        "axial_element_size_m": sizes.axial,
     });
     if args.json {
         print_json(&summary)

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use modal_bank::{BankCache, CacheKey, ModeBank, RadiationTable};
 use modal_fem::Material;
+use modal_mesh::generate::ElementSizes;
 use modal_mesh::{Cells, TetMesh};
 use modal_precompute::{MeshSource, Request};
 use modal_scene::{BankProvider, BankRequest, ProvidedBank, ProviderError, Scene};
@@ -66,14 +67,14 @@ impl BankProvider for PipelineProvider<'_> {
         let source = match mesh {
             modal_scene::MeshSource::File(path) => MeshSource::File(path.clone()),
             modal_scene::MeshSource::Generate(spec) => {
-                let (shape, h, order, identity) = recipe(spec, request)?;
+                let (shape, sizes, order, identity) = recipe(spec, request)?;
                 // The cache key of a generated mesh is its recipe: a cached
                 // bank is served without generating the mesh at all.
                 if let Some(bank) = self.cached_generated(request, &material, &identity, &what)? {
                     return Ok(bank);
                 }
                 // At the requested order, so curved shapes get curved (P2) boundaries.
-                let mesh = modal_mesh::generate::generate(&shape, h, order)?;
+                let mesh = modal_mesh::generate::generate_sized(&shape, sizes, order)?;
                 MeshSource::Memory { mesh, identity }
             }
         };
@@ -162,12 +163,15 @@ impl BankProvider for PipelineProvider<'_> {
 fn recipe(
     spec: &modal_scene::GeneratorSpec,
     request: &BankRequest,
-) -> Result<(modal_mesh::generate::Shape, f64, u8, String), ProviderError> {
+) -> Result<(modal_mesh::generate::Shape, ElementSizes, u8, String), ProviderError> {
     let shape = spec.shape()?;
     let order = request.order.unwrap_or(2);
-    let h = spec.element_size.unwrap_or_else(|| shape.default_element_size(order));
-    let identity = format!("generated {shape:?} h={h:e}");
-    Ok((shape, h, order, identity))
+    let sizes = spec.element_size.map_or_else(|| shape.default_sizes(order), ElementSizes::uniform);
+    let mut identity = format!("generated {shape:?} h={:e}", sizes.h);
+    if sizes.axial != sizes.h {
+        identity.push_str(&format!(" axial={:e}", sizes.axial));
+    }
+    Ok((shape, sizes, order, identity))
 }
 
 impl PipelineProvider<'_> {

@@ -13,15 +13,33 @@ mod shapes;
 
 pub use boxes::box_mesh;
 pub use mapped::MAX_GENERATED_TETS;
-pub use shapes::{bowl, cylinder, sphere, tube};
+pub use shapes::{bowl, cylinder, sphere, tube, tube_sized};
 
 use crate::{to_quadratic, MeshError, TetMesh};
 use mapped::positive;
 
 /// Default budget of a generated order-2 mesh whose D_min/2 rule would give
-/// more (thin plates and bowls): about 12 000 tets (≈ 50 000 DOF),
+/// more (thin plates, bowls and long tubes): about 12 000 tets (≈ 50 000 DOF),
 /// the budget the tetrahedralizer's default has for compact solids.
 pub const DEFAULT_MAX_TETS: u64 = 12_000;
+
+/// Element sizes of a generated mesh [m]: `h` everywhere, except along a
+/// tube's axis, where it is `axial` (≥ `h` for a long thin tube's default,
+/// [`Shape::default_sizes`]; other shapes ignore it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElementSizes {
+    /// Size across and around.
+    pub h: f64,
+    /// Size along a tube's axis.
+    pub axial: f64,
+}
+
+impl ElementSizes {
+    /// `h` in every direction.
+    pub fn uniform(h: f64) -> Self {
+        ElementSizes { h, axial: h }
+    }
+}
 
 /// A shape to mesh; all lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,58 +115,76 @@ impl Shape {
     /// bowls"): a steel 15 × 10 cm plate 4 mm thick at one layer through
     /// the thickness (h = 4 mm) is within 0.6 % of two layers at 2 mm, the
     /// sheet at 14.7 mm within 0.3 % of 7.35 mm, a glass bowl (6 cm, 4 mm
-    /// wall) at its budget size within 0.64 % of 3 mm. Tubes keep D_min/2:
-    /// at the budget, a thin tube's shell modes were 31 % off.
+    /// wall) at its budget size within 0.64 % of 3 mm. Tubes: see
+    /// [`Shape::default_sizes`] (uniform cells at the budget put a thin
+    /// tube's shell modes 35 % high).
     ///
     /// Invalid dimensions give 1 m, so that the generator reports them.
     pub fn default_element_size(&self, order: u8) -> f64 {
+        self.default_sizes(order).h
+    }
+
+    /// [`Shape::default_element_size`] and, for a long tube, a longer size
+    /// along its axis: at order 2, when the uniform size would give more
+    /// than [`DEFAULT_MAX_TETS`] tets, the axial size grows until the budget
+    /// holds (at most length/20); if that is not enough, the cells around
+    /// and through the wall become twice the wall thickness (at least 16
+    /// around) and the axial size grows again.
+    /// Measured (BENCHMARKS "Thin plates and bowls"): a 1 m chime tube,
+    /// 25 mm radius, 1.5 mm wall, at 3 mm around and 24 mm along (12 852
+    /// tets) is within 0.42 % of 3 mm everywhere (102 204 tets) on its first
+    /// 12 modes; uniform cells at the budget (8.7 mm) put its shell modes
+    /// 35 % high (the cells' aspect ratio on a curved thin wall).
+    pub fn default_sizes(&self, order: u8) -> ElementSizes {
         let (thinnest, largest) = self.extents();
-        let h = if order == 1 {
-            (thinnest / 8.0).min(largest / 20.0)
+        let sizes = if order == 1 {
+            ElementSizes::uniform((thinnest / 8.0).min(largest / 20.0))
         } else {
             let accurate = (thinnest / 2.0).min(largest / 4.0);
-            match self {
-                Shape::Box { .. } | Shape::Bowl { .. } => self.within_budget(accurate, largest / 20.0),
-                // Measured: a 1 m chime tube (1.5 mm wall, 25 mm radius) within
-                // the budget (18 cells around) put its shell modes 31 % high.
-                Shape::Tube { .. } | Shape::Cylinder { .. } | Shape::Sphere { .. } => accurate,
+            match *self {
+                Shape::Box { .. } | Shape::Bowl { .. } => {
+                    ElementSizes::uniform(self.within_budget(accurate, largest / 20.0))
+                }
+                Shape::Tube { inner_radius, outer_radius, length } => {
+                    self.tube_within_budget(accurate, inner_radius, outer_radius, length)
+                }
+                Shape::Cylinder { .. } | Shape::Sphere { .. } => ElementSizes::uniform(accurate),
             }
         };
-        if h.is_finite() && h > 0.0 {
-            h
+        if [sizes.h, sizes.axial].iter().all(|s| s.is_finite() && *s > 0.0) {
+            sizes
         } else {
-            1.0
+            ElementSizes::uniform(1.0)
         }
     }
 
-    /// The smallest `h ≥ h_min` (and at most `h_max`) at which the generator
-    /// makes at most [`DEFAULT_MAX_TETS`] tets ([`Shape::tet_count`]);
-    /// `h_min` when it already does or `h_max` is not larger. Bisection on
-    /// a log scale (the count falls monotonically with `h`).
+    /// A tube's default sizes (see [`Shape::default_sizes`]).
+    fn tube_within_budget(&self, accurate: f64, inner: f64, outer: f64, length: f64) -> ElementSizes {
+        let fits = |sizes: ElementSizes| self.tet_count(sizes) <= DEFAULT_MAX_TETS;
+        let longer_along = |h: f64| {
+            let axial = smallest_fitting(h, (length / 20.0).max(h), |axial| fits(ElementSizes { h, axial }));
+            ElementSizes { h, axial }
+        };
+        // First only longer cells along the axis; then, if that is not
+        // enough, twice the wall around too.
+        let along = longer_along(accurate);
+        if fits(along) {
+            return along;
+        }
+        let wall = outer - inner;
+        longer_along(accurate.max((2.0 * wall).min(std::f64::consts::PI * (inner + outer) / 16.0)))
+    }
+
+    /// The smallest uniform `h ≥ h_min` (and at most `h_max`) at which the
+    /// generator makes at most [`DEFAULT_MAX_TETS`] tets ([`Shape::tet_count`]).
     fn within_budget(&self, h_min: f64, h_max: f64) -> f64 {
-        let fits = |h: f64| self.tet_count(h) <= DEFAULT_MAX_TETS;
-        if !(h_min > 0.0 && h_max > h_min) || fits(h_min) {
-            return h_min;
-        }
-        if !fits(h_max) {
-            return h_max;
-        }
-        let (mut lo, mut hi) = (h_min, h_max);
-        for _ in 0..60 {
-            let mid = (lo * hi).sqrt();
-            if fits(mid) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        hi
+        smallest_fitting(h_min, h_max, |h| self.tet_count(ElementSizes::uniform(h)) <= DEFAULT_MAX_TETS)
     }
 
-    /// Tets [`generate`] makes for this shape at element size `h` (computed
+    /// Tets [`generate_sized`] makes for this shape at `sizes` (computed
     /// from its cell counts; no mesh is built).
-    pub fn tet_count(&self, h: f64) -> u64 {
-        shapes::tet_count(self, h)
+    pub fn tet_count(&self, sizes: ElementSizes) -> u64 {
+        shapes::tet_count(self, sizes)
     }
 
     /// Exact volume of the shape (m³) (the meshes approach it as h → 0).
@@ -174,6 +210,34 @@ impl Shape {
 /// radius, an order other than 1 or 2, or a mesh of more than
 /// [`MAX_GENERATED_TETS`] tets.
 pub fn generate(shape: &Shape, h: f64, order: u8) -> Result<TetMesh, MeshError> {
+    generate_sized(shape, ElementSizes::uniform(h), order)
+}
+
+/// The smallest `x` in `[lo, hi]` with `fits(x)`, for `fits` monotone
+/// (false, then true): `lo` when it fits or the interval is empty, `hi`
+/// when nothing fits; bisection on a log scale.
+fn smallest_fitting(lo: f64, hi: f64, fits: impl Fn(f64) -> bool) -> f64 {
+    if !(lo > 0.0 && hi > lo) || fits(lo) {
+        return lo;
+    }
+    if !fits(hi) {
+        return hi;
+    }
+    let (mut lo, mut hi) = (lo, hi);
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if fits(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
+/// [`generate`] with the axial size of a tube set apart ([`ElementSizes`]).
+pub fn generate_sized(shape: &Shape, sizes: ElementSizes, order: u8) -> Result<TetMesh, MeshError> {
+    let h = sizes.h;
     positive("h", h)?;
     mapped::check_order(order)?;
     match *shape {
@@ -188,7 +252,7 @@ pub fn generate(shape: &Shape, h: f64, order: u8) -> Result<TetMesh, MeshError> 
         }
         Shape::Cylinder { radius, length } => cylinder(radius, length, h, order),
         Shape::Tube { inner_radius, outer_radius, length } => {
-            tube(inner_radius, outer_radius, length, h, order)
+            tube_sized(inner_radius, outer_radius, length, h, sizes.axial, order)
         }
         Shape::Sphere { radius } => sphere(radius, h, order),
         Shape::Bowl { radius, thickness } => bowl(radius, thickness, h, order),
@@ -211,8 +275,9 @@ mod budget_tests {
         ];
         for shape in shapes {
             for h in [0.002, 0.003, 0.004, 0.0075] {
-                let made = generate(&shape, h, 1).unwrap().cells.len() as u64;
-                assert_eq!(shape.tet_count(h), made, "{shape:?} at h = {h}");
+                let sizes = ElementSizes { h, axial: 2.5 * h };
+                let made = generate_sized(&shape, sizes, 1).unwrap().cells.len() as u64;
+                assert_eq!(shape.tet_count(sizes), made, "{shape:?} at {sizes:?}");
             }
         }
     }
@@ -221,11 +286,26 @@ mod budget_tests {
     /// accuracy study's rule.
     #[test]
     fn thin_shapes_are_meshed_within_the_budget_and_compact_ones_as_before() {
-        let chime = Shape::Tube { inner_radius: 0.0235, outer_radius: 0.025, length: 1.0 };
-        for shape in [Shape::Box { size: [0.3, 0.02, 0.012] }, Shape::Sphere { radius: 0.05 }, chime] {
+        let short_tube = Shape::Tube { inner_radius: 0.015, outer_radius: 0.02, length: 0.03 };
+        for shape in [Shape::Box { size: [0.3, 0.02, 0.012] }, Shape::Sphere { radius: 0.05 }, short_tube] {
             let (thinnest, largest) = shape.extents();
-            assert_eq!(shape.default_element_size(2), (thinnest / 2.0).min(largest / 4.0), "{shape:?}");
+            let accurate = (thinnest / 2.0).min(largest / 4.0);
+            assert_eq!(shape.default_sizes(2), ElementSizes::uniform(accurate), "{shape:?}");
         }
+        // A tube over the budget: first only longer along the axis.
+        let tube = Shape::Tube { inner_radius: 0.015, outer_radius: 0.02, length: 0.1 };
+        let sizes = tube.default_sizes(2);
+        assert!(
+            (sizes.h - 0.0025).abs() < 1e-12 && sizes.axial > sizes.h && sizes.axial <= 0.005,
+            "{sizes:?}"
+        );
+        assert!(tube.tet_count(sizes) <= DEFAULT_MAX_TETS);
+        // A long thin chime: twice its 1.5 mm wall around, longer cells along, within the budget.
+        let chime = Shape::Tube { inner_radius: 0.0235, outer_radius: 0.025, length: 1.0 };
+        let sizes = chime.default_sizes(2);
+        assert!((sizes.h - 0.003).abs() < 1e-12 && sizes.axial > 0.02 && sizes.axial <= 0.05, "{sizes:?}");
+        let made = generate_sized(&chime, sizes, 1).unwrap().cells.len() as u64;
+        assert!(made <= DEFAULT_MAX_TETS && made > DEFAULT_MAX_TETS / 2, "{made} tets");
         let sheet = Shape::Box { size: [0.9, 0.004, 0.6] };
         let bowl = Shape::Bowl { radius: 0.06, thickness: 0.004 };
         for shape in [Shape::Box { size: [0.15, 0.004, 0.1] }, sheet.clone(), bowl] {

@@ -21,7 +21,7 @@
 use std::f64::consts::PI;
 
 use super::mapped::{self, linspace, mid, ogrid, positive, smaller, total_tets, Block, BlockMesh};
-use super::Shape;
+use super::{ElementSizes, Shape};
 use crate::{MeshError, TetMesh};
 
 /// Half-size of the O-grid's core box in q-space (the unit ball has radius 1).
@@ -135,12 +135,27 @@ pub fn cylinder(radius: f64, length: f64, h: f64, order: u8) -> Result<TetMesh, 
 /// are placed by averaging in cylindrical coordinates, so they stay on the
 /// walls.
 pub fn tube(inner: f64, outer: f64, length: f64, h: f64, order: u8) -> Result<TetMesh, MeshError> {
+    tube_sized(inner, outer, length, h, h, order)
+}
+
+/// [`tube`] with cells of about `h` around and through the wall and
+/// `axial_h` along the axis (a long thin tube needs cells near its wall
+/// thickness around it, not along it).
+pub fn tube_sized(
+    inner: f64,
+    outer: f64,
+    length: f64,
+    h: f64,
+    axial_h: f64,
+    order: u8,
+) -> Result<TetMesh, MeshError> {
     positive("inner_radius", inner)?;
     positive("outer_radius", outer)?;
     positive("length", length)?;
     positive("h", h)?;
+    positive("axial h", axial_h)?;
     smaller("inner_radius", inner, "outer_radius", outer)?;
-    let (around, radii, zs) = tube_grid(inner, outer, length, h);
+    let (around, radii, zs) = tube_grid(inner, outer, length, h, axial_h);
     let (radii, zs) = (&radii, &zs);
     let block = Block {
         cells: [around, zs.len() - 1, radii.len() - 1],
@@ -164,9 +179,13 @@ pub fn tube(inner: f64, outer: f64, length: f64, h: f64, order: u8) -> Result<Te
 }
 
 /// The tube's cells around, and its radii and heights of grid lines.
-fn tube_grid(inner: f64, outer: f64, length: f64, h: f64) -> (usize, Vec<f64>, Vec<f64>) {
+fn tube_grid(inner: f64, outer: f64, length: f64, h: f64, axial_h: f64) -> (usize, Vec<f64>, Vec<f64>) {
     let around = cells_for(PI * (inner + outer), h).max(8);
-    (around, linspace(inner, outer, cells_for(outer - inner, h)), linspace(0.0, length, cells_for(length, h)))
+    (
+        around,
+        linspace(inner, outer, cells_for(outer - inner, h)),
+        linspace(0.0, length, cells_for(length, axial_h)),
+    )
 }
 
 /// The bowl's O-grid (its disk radius 1 maps to the arc π R_mid / 2 from
@@ -175,9 +194,10 @@ fn bowl_grid(radius: f64, thickness: f64, h: f64) -> (OGrid, Vec<f64>) {
     (OGrid::new(0.5 * PI * (radius - 0.5 * thickness), h), linspace(0.0, 1.0, cells_for(thickness, h)))
 }
 
-/// Tets the generator makes for `shape` at element size `h` (the same cell
-/// counts, no mesh built; saturating).
-pub(crate) fn tet_count(shape: &Shape, h: f64) -> u64 {
+/// Tets the generator makes for `shape` at `sizes` (the same cell counts,
+/// no mesh built; saturating).
+pub(crate) fn tet_count(shape: &Shape, sizes: ElementSizes) -> u64 {
+    let h = sizes.h;
     match *shape {
         Shape::Box { size } => mapped::tet_count(size.map(|s| cells_for(s, h))),
         Shape::Cylinder { radius, length } => {
@@ -186,7 +206,7 @@ pub(crate) fn tet_count(shape: &Shape, h: f64) -> u64 {
             total_tets(&blocks)
         }
         Shape::Tube { inner_radius, outer_radius, length } => {
-            let (around, radii, zs) = tube_grid(inner_radius, outer_radius, length, h);
+            let (around, radii, zs) = tube_grid(inner_radius, outer_radius, length, h, sizes.axial);
             mapped::tet_count([around, zs.len() - 1, radii.len() - 1])
         }
         Shape::Sphere { radius } => total_tets(&OGrid::new(radius, h).ball_blocks()),
