@@ -239,7 +239,7 @@ pub fn solve_clustered(
 ) -> Result<Vec<SurfaceField>, RadiationError> {
     let near = NearField::new(mesh);
     let disc = Discretization { mesh, near: &near, clusters, aggregate: true };
-    solve_on(&disc, air, frequency_hz, velocities, formulation)
+    solve_on(&disc, air, frequency_hz, velocities, formulation).map(|(fields, _)| fields)
 }
 
 /// What a solve is assembled on.
@@ -282,19 +282,9 @@ impl std::fmt::Display for SolverPath {
     }
 }
 
-/// [`solve_clustered`] on a prepared [`Discretization`].
+/// [`solve_clustered`] on a prepared [`Discretization`], also saying how
+/// the system was solved.
 pub fn solve_on(
-    disc: &Discretization<'_>,
-    air: Air,
-    frequency_hz: f64,
-    velocities: &[Vec<c64>],
-    formulation: Formulation,
-) -> Result<Vec<SurfaceField>, RadiationError> {
-    solve_on_reported(disc, air, frequency_hz, velocities, formulation).map(|(fields, _)| fields)
-}
-
-/// [`solve_on`], also saying how the system was solved.
-pub fn solve_on_reported(
     disc: &Discretization<'_>,
     air: Air,
     frequency_hz: f64,
@@ -489,6 +479,7 @@ mod tests {
                 let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate };
                 solve_on(&disc, air, f, std::slice::from_ref(&vel), Formulation::BurtonMiller)
                     .unwrap()
+                    .0
                     .remove(0)
             };
             let (each, summed) = (field(false), field(true));
@@ -532,7 +523,7 @@ mod tests {
         ));
     }
 
-    /// `solve_on_reported` names the path each size takes.
+    /// `solve_on` names the path each size takes.
     #[test]
     fn the_report_names_how_each_system_was_solved() {
         let air = Air::default();
@@ -542,8 +533,7 @@ mod tests {
             let (near, clusters) = (NearField::new(&mesh), Clusters::identity(mesh.len()));
             let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate: true };
             let (fields, path) =
-                solve_on_reported(&disc, air, 1000.0, std::slice::from_ref(&vel), Formulation::BurtonMiller)
-                    .unwrap();
+                solve_on(&disc, air, 1000.0, std::slice::from_ref(&vel), Formulation::BurtonMiller).unwrap();
             assert_eq!(fields.len(), 1);
             (mesh.len(), path)
         };

@@ -52,10 +52,7 @@ pub mod quadrature;
 mod sincos;
 pub mod special;
 
-pub use bem::{
-    solve, solve_clustered, solve_on, solve_on_reported, Air, Discretization, Formulation, SolverPath,
-    SurfaceField,
-};
+pub use bem::{solve, solve_clustered, solve_on, Air, Discretization, Formulation, SolverPath, SurfaceField};
 pub use cluster::{Adjacency, Clusters};
 pub use error::RadiationError;
 /// Complex f64 (`num_complex::Complex<f64>`), the amplitude type of every field.

@@ -18,7 +18,7 @@ use std::time::Instant;
 use faer::c64;
 use modal_bank::ModeBank;
 
-use crate::bem::{solve_on_reported, Air, Discretization, Formulation, SolverPath, SurfaceField};
+use crate::bem::{solve_on, Air, Discretization, Formulation, SolverPath, SurfaceField};
 use crate::cluster::{Adjacency, Clusters};
 use crate::error::RadiationError;
 use crate::geometry::{dot, BoundaryMesh};
@@ -582,7 +582,7 @@ pub fn radiate_modes_on(
         let near_s = if fresh { t0.elapsed().as_secs_f64() } else { 0.0 };
         let disc =
             Discretization { mesh, near, clusters: &plan.clusters, aggregate: opts.adaptive_resolution };
-        let (surfaces, solver) = solve_on_reported(&disc, opts.air, f, &fields, opts.formulation)?;
+        let (surfaces, solver) = solve_on(&disc, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
