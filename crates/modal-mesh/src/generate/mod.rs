@@ -41,11 +41,16 @@ impl ElementSizes {
     }
 }
 
-/// The widest a default cell of a thin plate or bowl may be, in wall
+/// The widest a default cell of a thin flat plate may be, in wall
 /// thicknesses (one layer of quadratic tets through the wall): flatter
 /// cells stiffen bending (measured: a 1 m steel sheet 1 mm thick at 22.7
-/// thicknesses was up to 9 % high against half that size).
-pub const MAX_CELL_PER_WALL: f64 = 4.0;
+/// thicknesses was up to 9 % high against half that size; 0.38 % at 4).
+pub const MAX_FLAT_CELL_PER_WALL: f64 = 4.0;
+
+/// The same on a curved wall (a bowl; a tube around its axis), where flat
+/// cells stiffen sooner: a 10 cm glass bowl with a 2 mm wall was up to
+/// 1.18 % high at 4 thicknesses and 0.12 % at 2, against 1.5.
+pub const MAX_CURVED_CELL_PER_WALL: f64 = 2.0;
 
 /// The longest a long tube's default cell may be along its axis, in wall
 /// thicknesses (measured: a 1 m aluminium tube with a 0.5 mm wall at 100
@@ -122,7 +127,8 @@ impl Shape {
     /// need, and a 0.9 × 0.6 m sheet 4 mm thick (8.1 M DOF) more than any
     /// machine holds: the size then grows until the mesh has at most
     /// [`DEFAULT_MAX_TETS`] tets ([`Shape::tet_count`]), but never beyond
-    /// D_max/20 nor [`MAX_CELL_PER_WALL`] wall thicknesses (a thinner,
+    /// D_max/20 nor [`MAX_FLAT_CELL_PER_WALL`] (bowl:
+    /// [`MAX_CURVED_CELL_PER_WALL`]) wall thicknesses (a thinner,
     /// wider plate keeps more tets, and the memory guard refuses what does
     /// not fit). Measured (first 12 modes, BENCHMARKS "Thin plates and
     /// bowls"): a steel 15 × 10 cm plate 4 mm thick at one layer through
@@ -158,9 +164,11 @@ impl Shape {
             let accurate = (thinnest / 2.0).min(largest / 4.0);
             match *self {
                 Shape::Box { .. } | Shape::Bowl { .. } => {
-                    // Cells up to 4 wall thicknesses wide: measured 0.3 % at 4.1 (the
-                    // 4 mm sheet), up to 9 % at 22.7 (a 1 mm sheet 1 m wide).
-                    let widest = (largest / 20.0).min(MAX_CELL_PER_WALL * thinnest).max(accurate);
+                    let per_wall = match self {
+                        Shape::Bowl { .. } => MAX_CURVED_CELL_PER_WALL,
+                        _ => MAX_FLAT_CELL_PER_WALL,
+                    };
+                    let widest = (largest / 20.0).min(per_wall * thinnest).max(accurate);
                     ElementSizes::uniform(self.within_budget(accurate, widest))
                 }
                 Shape::Tube { inner_radius, outer_radius, length } => {
@@ -193,7 +201,10 @@ impl Shape {
         if fits(along) {
             return along;
         }
-        longer_along(accurate.max((2.0 * wall).min(std::f64::consts::PI * (inner + outer) / 16.0)))
+        longer_along(
+            accurate
+                .max((MAX_CURVED_CELL_PER_WALL * wall).min(std::f64::consts::PI * (inner + outer) / 16.0)),
+        )
     }
 
     /// The smallest uniform `h ≥ h_min` (and at most `h_max`) at which the
@@ -337,13 +348,16 @@ mod budget_tests {
             let made = generate(&shape, h, 1).unwrap().cells.len();
             assert!(made as u64 <= DEFAULT_MAX_TETS, "{shape:?}: {made} tets at h = {h}");
         }
+        // A 10 cm bowl with a 2 mm wall: at most 2 thicknesses wide.
+        let wide_bowl = Shape::Bowl { radius: 0.1, thickness: 0.002 };
+        assert_eq!(wide_bowl.default_element_size(2), MAX_CURVED_CELL_PER_WALL * 0.002);
         // A 1 mm sheet 1 m wide: at most 4 thicknesses wide, over the budget.
         let foil = Shape::Box { size: [1.0, 0.001, 1.0] };
-        assert_eq!(foil.default_element_size(2), MAX_CELL_PER_WALL * 0.001);
+        assert_eq!(foil.default_element_size(2), MAX_FLAT_CELL_PER_WALL * 0.001);
         // The sheet: one layer through its 4 mm, 4 thicknesses across (the budget
         // alone would allow 16.4 mm): a little over the budget.
         let h = sheet.default_element_size(2);
-        assert_eq!(h, MAX_CELL_PER_WALL * 0.004);
+        assert_eq!(h, MAX_FLAT_CELL_PER_WALL * 0.004);
         let made = generate(&sheet, h, 1).unwrap().cells.len() as u64;
         assert!(made > DEFAULT_MAX_TETS && made < 11 * DEFAULT_MAX_TETS / 10, "{made} tets");
         // Order 1 keeps its rule (linear tets lock in bending: no coarsening).
