@@ -30,6 +30,11 @@
 //! The kernel points of the fixed rules (centroid, 3-point, the near
 //! remainder's 7 points, the far clusters' centroids) are gathered as a
 //! row is swept and evaluated together in SIMD lanes ([`crate::batch`]).
+//! A source cluster whose every panel takes the same far rule from the
+//! row's centre (decided once from the cluster's bounds,
+//! [`Assembly::uniform_far_rule`]) is read in place from columns kept for
+//! the whole assembly instead of being tested and gathered panel by panel:
+//! the same points, bits and order of sums.
 //!
 //! Rows are assembled in parallel, each by one thread in a fixed order:
 //! bit-identical for any thread count.
@@ -37,7 +42,7 @@
 use faer::c64;
 use rayon::prelude::*;
 
-use crate::batch::{Formula, SourcePoints};
+use crate::batch::{Formula, SourceColumns, SourcePoints};
 use crate::cluster::Clusters;
 use crate::geometry::{dot, norm, sub, BoundaryMesh, Panel};
 use crate::kernels::{CoupledKernels, Kernels, REMAINDER_MAX_KH};
@@ -113,8 +118,8 @@ impl SourcePanel {
 /// A cluster as test region and as source: its panels with area weights,
 /// its area-weighted centre and normal, its radius about the centre
 /// (member centroid distance plus diameter), its area, the area-weighted
-/// sum of its normals, its largest panel diameter, and its panels' range
-/// in [`Assembly::sources`].
+/// sum of its normals, its largest and smallest panel diameters, and its
+/// panels' range in [`Assembly::sources`].
 struct Region {
     members: Vec<(usize, f64)>,
     centre: [f64; 3],
@@ -122,6 +127,7 @@ struct Region {
     radius: f64,
     normal_sum: [f64; 3],
     max_diameter: f64,
+    min_diameter: f64,
     span: std::ops::Range<usize>,
 }
 
@@ -146,9 +152,10 @@ fn regions(mesh: &BoundaryMesh, clusters: &Clusters) -> (Vec<Region>, Vec<Source
                 .map(|&p| norm(sub(mesh.panels[p].centroid, centre)) + mesh.panels[p].diameter)
                 .fold(0.0, f64::max);
             let max_diameter = m.iter().map(|&p| mesh.panels[p].diameter).fold(0.0, f64::max);
+            let min_diameter = m.iter().map(|&p| mesh.panels[p].diameter).fold(f64::INFINITY, f64::min);
             let members = m.iter().map(|&p| (p, mesh.panels[p].area / area)).collect();
             let normal = normal_sum.map(|x| x / len);
-            Region { members, centre, normal, radius, normal_sum, max_diameter, span: 0..0 }
+            Region { members, centre, normal, radius, normal_sum, max_diameter, min_diameter, span: 0..0 }
         })
         .collect::<Vec<_>>();
     let mut sources = Vec::with_capacity(mesh.len());
@@ -185,6 +192,13 @@ pub(crate) struct Assembly<'a> {
     regions: Vec<Region>,
     sources: Vec<SourcePanel>,
     moments: Vec<Vec<Moments>>,
+    /// The source panels' centroid-rule points and 3-point-rule points
+    /// (three per panel) as columns, in [`Assembly::sources`] order, and
+    /// the velocity fields in that order: the far panels of a source
+    /// cluster seen from one point ([`Assembly::add_far_panels`]).
+    centroid_points: SourceColumns,
+    three_points: SourceColumns,
+    q_in_source_order: Vec<Vec<c64>>,
 }
 
 impl<'a> Assembly<'a> {
@@ -225,7 +239,31 @@ impl<'a> Assembly<'a> {
             })
             .collect();
         let coupled = CoupledKernels::new(kern.k(), alpha);
-        Assembly { mesh, near_field, kern, alpha, q, aggregate, coupled, regions, sources, moments }
+        let (mut centroid_points, mut three_points) = (SourceColumns::default(), SourceColumns::default());
+        for src in &sources {
+            // The weights exactly as the gathered rules form them (`1·A`, `1·w_q·A`).
+            centroid_points.push(src.centroid, src.normal, src.area);
+            for (y, (_, wq)) in src.points.iter().zip(TRIANGLE_3) {
+                three_points.push(*y, src.normal, wq * src.area);
+            }
+        }
+        debug_assert_eq!(three_points.len(), 3 * centroid_points.len());
+        let q_in_source_order = q.iter().map(|qf| sources.iter().map(|s| qf[s.index]).collect()).collect();
+        Assembly {
+            mesh,
+            near_field,
+            kern,
+            alpha,
+            q,
+            aggregate,
+            coupled,
+            regions,
+            sources,
+            moments,
+            centroid_points,
+            three_points,
+            q_in_source_order,
+        }
     }
 
     /// Number of unknowns (clusters).
@@ -286,6 +324,11 @@ impl<'a> Assembly<'a> {
                 g.far.push((region.centre, region.normal), src.centre, [0.0; 3], 1.0, slot_index, c);
                 continue;
             }
+            if let Some(rule) = self.uniform_far_rule(region, src, r) {
+                self.add_far_panels(region, src, rule, slot, b);
+                continue;
+            }
+
             for panel in &self.sources[src.span.clone()] {
                 let (a, op) = self.pair(i, panel, slot_index, g);
                 *slot += a;
@@ -297,6 +340,53 @@ impl<'a> Assembly<'a> {
         self.add_gathered(&mut g.coupled, Formula::Coupled, row, b);
         self.add_gathered(&mut g.remainder, Formula::Remainder, row, b);
         self.add_far_clusters(i, &mut g.far, row, b);
+    }
+
+    /// The one rule [`Assembly::off_panel`] would take for every panel of
+    /// source cluster `src` (centre `r` from `region`'s) seen from
+    /// `region`'s centre, when there is one: every panel is then off the
+    /// near tests ([`is_near`]) and integrated by its centroid, or every
+    /// panel by the 3-point rule. Each panel's centroid is at least
+    /// `r − ρ_src + h_j` from the centre, so bounds on the cluster decide for
+    /// all of its panels at once.
+    fn uniform_far_rule(&self, region: &Region, src: &Region, r: f64) -> Option<OffRule> {
+        let (clear, h_max) = (r - src.radius, src.max_diameter);
+        let off_near = region.members.len() > 1
+            && clear >= CLUSTER_NEAR_RATIO * (region.radius + h_max)
+            && clear >= region.radius + MID_POINT_RATIO * h_max;
+        if !off_near {
+            return None;
+        }
+        let k = self.kern.k();
+        if k * h_max <= 1.0 && clear > FAR_POINT_RATIO * h_max {
+            Some(OffRule::Centroid)
+        } else if k * src.min_diameter > 1.0
+            && k * h_max <= THREE_POINT_MAX_KH
+            && clear > MID_POINT_RATIO * h_max
+        {
+            Some(OffRule::ThreePoint)
+        } else {
+            None
+        }
+    }
+
+    /// Adds source cluster `src`'s panels, every one by `rule` seen from
+    /// `region`'s centre ([`Assembly::uniform_far_rule`]), to the row entry
+    /// `slot` and its right-hand-side parts `b`: the points are read from
+    /// the assembly's columns instead of gathered, and summed in the order
+    /// (and with the bits) the gathered path would sum them.
+    fn add_far_panels(&self, region: &Region, src: &Region, rule: OffRule, slot: &mut c64, b: &mut [c64]) {
+        let (columns, per_panel) = match rule {
+            OffRule::Centroid => (&self.centroid_points, 1),
+            _ => (&self.three_points, 3),
+        };
+        let range = per_panel * src.span.start..per_panel * src.span.end;
+        columns.for_each_coupled(&self.coupled, (region.centre, region.normal), range, |p, a, op| {
+            *slot += a;
+            for (bf, qf) in b.iter_mut().zip(&self.q_in_source_order) {
+                *bf += op * qf[p / per_panel];
+            }
+        });
     }
 
     /// Evaluates the far source clusters gathered in `pts` (one point at

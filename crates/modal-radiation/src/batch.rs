@@ -279,21 +279,9 @@ fn evaluate_lanes<const F: u8, const LIBM: bool>(
     let (a_re, a_im, op_re, op_im) = (&mut a_re[..n], &mut a_im[..n], &mut op_re[..n], &mut op_im[..n]);
     let (q_re, q_im) = (&mut q_re[..n], &mut q_im[..n]);
     for i in 0..n {
-        let d = [y0[i] - x0[i], y1[i] - x1[i], y2[i] - x2[i]];
-        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        let r = r2.sqrt();
-        let kr = k * r;
-        beyond |= u64::from(kr > MAX_ARGUMENT);
-        let (sn, cs) = if LIBM { kr.sin_cos() } else { sin_cos(kr) };
-        let point = Point {
-            kr,
-            e: [cs, sn],
-            scale: w[i] / (FOUR_PI * r),
-            u: 1.0 / r2,
-            dny: d[0] * n0[i] + d[1] * n1[i] + d[2] * n2[i],
-            dnx: d[0] * m0[i] + d[1] * m1[i] + d[2] * m2[i],
-            nxny: m0[i] * n0[i] + m1[i] * n1[i] + m2[i] * n2[i],
-        };
+        let observer = ([x0[i], x1[i], x2[i]], [m0[i], m1[i], m2[i]]);
+        let point = Point::at::<LIBM>(k, observer, [y0[i], y1[i], y2[i]], [n0[i], n1[i], n2[i]], w[i]);
+        beyond |= u64::from(point.kr > MAX_ARGUMENT);
         let (a, op) = match F {
             REMAINDER => point.remainder(c),
             LINEAR => {
@@ -333,6 +321,33 @@ fn mul(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
 }
 
 impl Point {
+    /// Source point `y` (normal `n`, weight `w`) seen from `(x, nx)` at
+    /// wavenumber `k`; `LIBM` picks libm's `sin_cos` over
+    /// [`crate::sincos`] (valid to [`MAX_ARGUMENT`], the caller checks).
+    #[inline(always)]
+    fn at<const LIBM: bool>(
+        k: f64,
+        (x, nx): ([f64; 3], [f64; 3]),
+        y: [f64; 3],
+        n: [f64; 3],
+        w: f64,
+    ) -> Point {
+        let d = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let r = r2.sqrt();
+        let kr = k * r;
+        let (sn, cs) = if LIBM { kr.sin_cos() } else { sin_cos(kr) };
+        Point {
+            kr,
+            e: [cs, sn],
+            scale: w / (FOUR_PI * r),
+            u: 1.0 / r2,
+            dny: d[0] * n[0] + d[1] * n[1] + d[2] * n[2],
+            dnx: d[0] * nx[0] + d[1] * nx[1] + d[2] * nx[2],
+            nxny: nx[0] * n[0] + nx[1] * n[1] + nx[2] * n[2],
+        }
+    }
+
     /// `(a, op)` of the coupled kernels (module doc).
     #[inline(always)]
     fn coupled(&self, c: &CoupledKernels) -> ([f64; 2], [f64; 2]) {
@@ -388,6 +403,141 @@ impl Point {
         let al_dnx = mul(al, dg_dnx);
         ([-dg_dny[0] - al_d2g[0], -dg_dny[1] - al_d2g[1]], [-g[0] - al_dnx[0], -g[1] - al_dnx[1]])
     }
+}
+
+/// Source points kept as columns for the whole assembly (structure of
+/// arrays: positions, normals, weights), to be seen from one observer at a
+/// time by [`SourceColumns::for_each_coupled`]: the far panels of a source
+/// cluster ([`crate::assembly`]) without gathering them point by point.
+#[derive(Default)]
+pub(crate) struct SourceColumns {
+    y: [Vec<f64>; 3],
+    n: [Vec<f64>; 3],
+    w: Vec<f64>,
+}
+
+impl SourceColumns {
+    /// Appends source point `y` (normal `n`, weight `w`).
+    pub(crate) fn push(&mut self, y: [f64; 3], n: [f64; 3], w: f64) {
+        for k in 0..3 {
+            self.y[k].push(y[k]);
+            self.n[k].push(n[k]);
+        }
+        self.w.push(w);
+    }
+
+    /// Number of points.
+    pub(crate) fn len(&self) -> usize {
+        self.w.len()
+    }
+
+    /// The coupled weights `(a, op)` (module doc) of points `range` seen
+    /// from `observer` (point, normal), handed to `sink` with each point's
+    /// index in order: the same bits as [`SourcePoints::evaluate`] of the
+    /// same points by [`Formula::Coupled`] (the same per-point arithmetic,
+    /// [`Point::at`], in lanes [`CHUNK`] at a time; a chunk with some `k·r`
+    /// beyond [`MAX_ARGUMENT`] takes libm's `sin_cos`, as a gathered block does).
+    pub(crate) fn for_each_coupled(
+        &self,
+        c: &CoupledKernels,
+        observer: ([f64; 3], [f64; 3]),
+        range: Range<usize>,
+        mut sink: impl FnMut(usize, c64, c64),
+    ) {
+        let mut out = ChunkWeights::default();
+        for start in range.clone().step_by(CHUNK) {
+            let part = start..range.end.min(start + CHUNK);
+            if !observed_polynomial(c, observer, self.slices(part.clone()), &mut out) {
+                observed_lanes::<true>(c, observer, self.slices(part.clone()), &mut out);
+            }
+            for (i, p) in part.enumerate() {
+                sink(p, c64::new(out.a[0][i], out.a[1][i]), c64::new(out.op[0][i], out.op[1][i]));
+            }
+        }
+    }
+
+    /// The columns of points `range`.
+    fn slices(&self, range: Range<usize>) -> ObservedSources<'_> {
+        let (y, n) = (&self.y, &self.n);
+        ObservedSources {
+            y: [&y[0][range.clone()], &y[1][range.clone()], &y[2][range.clone()]],
+            n: [&n[0][range.clone()], &n[1][range.clone()], &n[2][range.clone()]],
+            w: &self.w[range],
+        }
+    }
+}
+
+/// Up to [`CHUNK`] points' columns, all seen from one observer.
+struct ObservedSources<'a> {
+    y: [&'a [f64]; 3],
+    n: [&'a [f64]; 3],
+    w: &'a [f64],
+}
+
+/// `(a, op)` of up to [`CHUNK`] points, real and imaginary parts.
+struct ChunkWeights {
+    a: [[f64; CHUNK]; 2],
+    op: [[f64; CHUNK]; 2],
+}
+
+impl Default for ChunkWeights {
+    fn default() -> Self {
+        ChunkWeights { a: [[0.0; CHUNK]; 2], op: [[0.0; CHUNK]; 2] }
+    }
+}
+
+/// [`observed_lanes`] with the polynomial `sin_cos`, compiled for AVX2 when
+/// the CPU has it; false when some `k·r` was beyond its range.
+fn observed_polynomial(
+    c: &CoupledKernels,
+    observer: ([f64; 3], [f64; 3]),
+    src: ObservedSources<'_>,
+    out: &mut ChunkWeights,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: observed_avx2's one requirement, AVX2, was just detected.
+        return unsafe { observed_avx2(c, observer, src, out) };
+    }
+    observed_lanes::<false>(c, observer, src, out)
+}
+
+/// [`observed_lanes`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn observed_avx2(
+    c: &CoupledKernels,
+    observer: ([f64; 3], [f64; 3]),
+    src: ObservedSources<'_>,
+    out: &mut ChunkWeights,
+) -> bool {
+    observed_lanes::<false>(c, observer, src, out)
+}
+
+/// The coupled weights of `src` seen from `observer`, the loop the
+/// compiler vectorizes (like [`evaluate_lanes`], whose per-point
+/// arithmetic it shares through [`Point::at`]).
+#[inline(always)]
+fn observed_lanes<const LIBM: bool>(
+    c: &CoupledKernels,
+    observer: ([f64; 3], [f64; 3]),
+    src: ObservedSources<'_>,
+    out: &mut ChunkWeights,
+) -> bool {
+    let (k, n) = (c.k(), src.w.len().min(CHUNK));
+    let mut beyond = 0u64;
+    let (y0, y1, y2) = (&src.y[0][..n], &src.y[1][..n], &src.y[2][..n]);
+    let (n0, n1, n2) = (&src.n[0][..n], &src.n[1][..n], &src.n[2][..n]);
+    let w = &src.w[..n];
+    let ChunkWeights { a: [a_re, a_im], op: [op_re, op_im] } = out;
+    let (a_re, a_im, op_re, op_im) = (&mut a_re[..n], &mut a_im[..n], &mut op_re[..n], &mut op_im[..n]);
+    for i in 0..n {
+        let point = Point::at::<LIBM>(k, observer, [y0[i], y1[i], y2[i]], [n0[i], n1[i], n2[i]], w[i]);
+        beyond |= u64::from(point.kr > MAX_ARGUMENT);
+        let (a, op) = point.coupled(c);
+        (a_re[i], a_im[i], op_re[i], op_im[i]) = (a[0], a[1], op[0], op[1]);
+    }
+    LIBM || beyond == 0
 }
 
 #[cfg(test)]
@@ -455,6 +605,32 @@ mod tests {
             let (a1, op1) = pts.weights(p);
             close(a1, *a, &format!("libm a at point {p}"));
             close(op1, *op, &format!("libm op at point {p}"));
+        }
+    }
+
+    #[test]
+    fn columns_seen_from_one_point_give_the_gathered_bits() {
+        // SourceColumns (the far panels of a cluster, read in place) against
+        // the same points gathered one by one: equal bits, in order, across
+        // several chunks and a ragged last one.
+        let (k, alpha) = (275.0, c64::new(0.0, 1.0 / 275.0));
+        let kernels = CoupledKernels::new(k, alpha);
+        let observer = ([0.01, -0.02, 0.03], [0.0, 0.6, 0.8]);
+        let (mut pts, mut columns) = (SourcePoints::default(), SourceColumns::default());
+        for i in 0..150 {
+            let t = i as f64;
+            let y = [0.05 * (0.37 * t).cos(), 0.04 * (0.53 * t).sin(), 0.002 * t - 0.1];
+            let n = [(0.3 * t).sin(), (0.3 * t).cos(), 0.0];
+            let w = 1e-6 * (1.0 + 0.1 * t);
+            pts.push(observer, y, n, w, 0, i);
+            columns.push(y, n, w);
+        }
+        pts.evaluate(&kernels, Formula::Coupled);
+        let mut seen = Vec::new();
+        columns.for_each_coupled(&kernels, observer, 7..150, |p, a, op| seen.push((p, a, op)));
+        assert_eq!(seen.len(), 143);
+        for (p, a, op) in seen {
+            assert_eq!((a, op), pts.weights(p), "point {p}");
         }
     }
 
