@@ -45,7 +45,7 @@ fn describe(stage: &Stage) -> String {
 pub const MEMORY_LIMIT_ENV: &str = "MODAL_MEMORY_LIMIT_GB";
 
 /// The memory limit [bytes] set by [`MEMORY_LIMIT_ENV`], if any.
-fn memory_limit_from_env() -> Result<Option<u64>> {
+pub fn memory_limit_from_env() -> Result<Option<u64>> {
     let Some(text) = std::env::var_os(MEMORY_LIMIT_ENV) else { return Ok(None) };
     let text = text.to_string_lossy();
     match text.trim().parse::<f64>() {

@@ -17,7 +17,7 @@ use modal_synth::WavFormat;
 use super::args::{RadiationChoice, RenderArgs};
 use super::interrupt;
 use super::output::{print_json, warn};
-use super::precompute::open_cache;
+use super::precompute::{memory_limit_from_env, open_cache};
 use super::progress::Spinner;
 
 /// Default `--transfer-max-freq` [Hz]: modes up to it get their acoustic
@@ -49,6 +49,41 @@ struct PipelineProvider<'a> {
     radiation_solved: Vec<(String, usize, f64)>,
     /// Highest mode frequency whose transfer is solved [Hz] (`--transfer-max-freq`).
     transfer_max_hz: f64,
+    /// The solver's memory guard [bytes] when `MODAL_MEMORY_LIMIT_GB` sets it
+    /// (else the eigensolver's default).
+    memory_limit_bytes: Option<u64>,
+}
+
+/// Refuses a generated shape whose quadratic mesh could not fit the memory
+/// guard, from its exact tet count alone and before generating it (a
+/// 3.3 M-tet tube took 50 s to generate only to be refused by the
+/// assembly's own check): K and M of `T` 10-node tets hold at least
+/// [`modal_fem::min_quadratic_matrices_bytes`]. Linear meshes have no such
+/// bound per tet and are left to that check.
+fn refuse_beyond_memory(
+    shape: &modal_mesh::generate::Shape,
+    sizes: modal_mesh::generate::ElementSizes,
+    order: u8,
+    limit_bytes: Option<u64>,
+    what: &str,
+) -> Result<(), ProviderError> {
+    let Some(limit) = limit_bytes.or_else(modal_eigen::default_memory_limit) else { return Ok(()) };
+    if order != 2 {
+        return Ok(());
+    }
+    let tets = shape.tet_count(sizes);
+    let needed = modal_fem::min_quadratic_matrices_bytes(tets);
+    if needed <= limit {
+        return Ok(());
+    }
+    Err(format!(
+        "{what}: its element size {:.3e} m gives {tets} quadratic tets, whose stiffness and mass matrices alone \
+         would need at least {:.2} GB, above the memory limit of {:.2} GB; give a larger element_size",
+        sizes.h,
+        needed as f64 / 1e9,
+        limit as f64 / 1e9
+    )
+    .into())
 }
 
 impl BankProvider for PipelineProvider<'_> {
@@ -73,6 +108,7 @@ impl BankProvider for PipelineProvider<'_> {
                 if let Some(bank) = self.cached_generated(request, &material, &identity, &what)? {
                     return Ok(bank);
                 }
+                refuse_beyond_memory(&shape, sizes, order, self.memory_limit_bytes, &what)?;
                 // At the requested order, so curved shapes get curved (P2) boundaries.
                 let mesh = modal_mesh::generate::generate_sized(&shape, sizes, order)?;
                 MeshSource::Memory { mesh, identity }
@@ -299,6 +335,7 @@ impl PipelineProvider<'_> {
         // No modes above the scene's Nyquist frequency are worth solving for.
         pipeline.max_freq_hz = request.max_frequency_hz;
         pipeline.threads = self.threads;
+        pipeline.memory_limit_bytes = self.memory_limit_bytes;
         pipeline
     }
 
@@ -412,6 +449,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         deferred_failed: Arc::new(AtomicBool::new(false)),
         radiation_solved: Vec::new(),
         transfer_max_hz: args.transfer_max_freq.unwrap_or(DEFAULT_TRANSFER_MAX_HZ),
+        memory_limit_bytes: memory_limit_from_env()?,
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);

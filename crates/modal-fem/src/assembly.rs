@@ -34,6 +34,27 @@ pub fn matrices_bytes(nnz: u64, dofs: u64) -> u64 {
     5 * 8 * nnz + 3 * 8 * (dofs + 1)
 }
 
+/// Fewest distinct pairs of different nodes that share an element, per
+/// element, in any mesh of 10-node tets: 15.
+///
+/// Three kinds of node pair in one tet are shared by few others. Two
+/// mid-edge nodes on one face (12 pairs) and a corner with the mid-edge node
+/// of an edge of the opposite face (12 pairs) span that face, so at most
+/// the two tets on the face hold them; the mid-edge nodes of two opposite
+/// edges (3 pairs) span the tet itself. So `T` tets hold at least
+/// `12T/2 + 12T/2 + 3T = 15T` such pairs, whatever their shape or sizes.
+/// (The structured meshes of `modal_mesh::generate` measure 383 stored
+/// entries per tet against the `2·9·15 = 270` this bound gives.)
+pub const MIN_NODE_PAIRS_PER_QUADRATIC_TET: u64 = 15;
+
+/// The fewest bytes [`matrices_bytes`] can be for a mesh of `tets` 10-node
+/// tets ([`MIN_NODE_PAIRS_PER_QUADRATIC_TET`]: each pair is a 3 × 3 block on
+/// both sides of the diagonal): a lower bound known from the element count
+/// alone, before the mesh exists.
+pub fn min_quadratic_matrices_bytes(tets: u64) -> u64 {
+    matrices_bytes(2 * 9 * MIN_NODE_PAIRS_PER_QUADRATIC_TET * tets, 0)
+}
+
 /// Assembled global stiffness `k` \[N/m\] and consistent mass `m` \[kg\], both
 /// `3·nodes × 3·nodes`, full symmetric storage, same sparsity pattern.
 #[derive(Clone, Debug)]

@@ -23,7 +23,10 @@ mod material;
 pub mod quadrature;
 mod rigid;
 
-pub use assembly::{assemble, matrices_bytes, prepare_mesh, Assembly, SparsityPattern, DEFAULT_ORDER};
+pub use assembly::{
+    assemble, matrices_bytes, min_quadratic_matrices_bytes, prepare_mesh, Assembly, SparsityPattern,
+    DEFAULT_ORDER, MIN_NODE_PAIRS_PER_QUADRATIC_TET,
+};
 pub use constraints::{fix_box, restrict, DofMap, Restricted};
 pub use error::FemError;
 pub use export::{write_matrix_market, write_nodes_csv};

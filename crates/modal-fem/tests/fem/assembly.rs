@@ -188,3 +188,33 @@ fn a_pattern_beyond_the_memory_limit_is_refused_with_what_it_would_need() {
         other => panic!("expected TooLarge, got {other:?}"),
     }
 }
+
+#[test]
+fn quadratic_meshes_hold_at_least_the_lower_bound_of_node_pairs() {
+    use modal_mesh::generate::{generate_sized, Shape};
+    // One tet (all 45 pairs distinct), a jiggled bar, and generated shapes
+    // whose tets meet in many ways (O-grids, wedges cut in three, a thin wall).
+    let one = TetMesh {
+        nodes: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        cells: Cells::Tet4(vec![[0, 1, 2, 3]]),
+        groups: Vec::new(),
+    };
+    let mut meshes = vec![prepare_mesh(&one, 2).unwrap(), small_mesh(2)];
+    for shape in [
+        Shape::Sphere { radius: 0.03 },
+        Shape::Cylinder { radius: 0.02, length: 0.1 },
+        Shape::Tube { inner_radius: 0.012, outer_radius: 0.014, length: 0.1 },
+        Shape::Bowl { radius: 0.05, thickness: 0.004 },
+    ] {
+        meshes.push(generate_sized(&shape, shape.default_sizes(2), 2).unwrap());
+    }
+    for mesh in &meshes {
+        let pattern = SparsityPattern::new(mesh).unwrap();
+        let tets = mesh.cells.len() as u64;
+        let bound = modal_fem::min_quadratic_matrices_bytes(tets);
+        let actual = modal_fem::matrices_bytes(pattern.nnz() as u64, pattern.dof_count() as u64);
+        assert!(actual >= bound, "{tets} tets: {actual} B below the bound {bound} B");
+        // Close enough to the truth to refuse what cannot fit: ≥ 40 % of it here.
+        assert!(bound as f64 >= 0.4 * actual as f64 || tets == 1, "{tets} tets: {bound} B vs {actual} B");
+    }
+}
