@@ -145,16 +145,27 @@ fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
 fn thin_plates_and_long_tubes_get_default_sizes_near_the_budget_and_report_them() {
     // 15 × 10 cm, 4 mm: D_min/2 would give 45 000 tets; the budget ≈ 12 000.
     let dir = temp_dir();
-    let written = modal(
-        dir.path(),
-        &["mesh", "box", "--size", "0.15,0.004,0.1", "--order", "2", "-o", "p.msh", "--json"],
-    )
-    .ok()
-    .json();
+    // No --order: the written mesh is quadratic, what precompute solves by default (at
+    // order 1 the same command wrote 2.88 M linear tets sized for linear elements).
+    let written =
+        modal(dir.path(), &["mesh", "box", "--size", "0.15,0.004,0.1", "-o", "p.msh", "--json"]).ok().json();
+    assert_eq!(written["order"], 2, "{written}");
     let h = written["element_size_m"].as_f64().unwrap();
     assert!(h > 0.002 && h < 0.0075, "h = {h}");
     assert!(written["tets"].as_u64().unwrap() <= 12_000, "{written}");
     assert_eq!(written["axial_element_size_m"].as_f64(), Some(h), "a box is uniform");
+    // A disc 20 cm across and 2 mm thick is a plate too.
+    let disc = modal(
+        dir.path(),
+        &["mesh", "cylinder", "--radius", "0.1", "--length", "0.002", "-o", "d.msh", "--json"],
+    )
+    .ok()
+    .json();
+    assert!(disc["tets"].as_u64().unwrap() <= 12_000, "{disc}");
+    // Linear tets on request keep the linear rule (D_min/8).
+    let linear = ["mesh", "box", "--size", "0.1,0.02,0.01", "--order", "1", "-o", "l.msh", "--json"];
+    let linear = modal(dir.path(), &linear).ok().json();
+    assert_eq!((linear["order"].as_u64(), linear["element_size_m"].as_f64()), (Some(1), Some(0.01 / 8.0)));
     // A 1 m chime tube, 1.5 mm wall: twice the wall around, 16 walls along the axis
     // (a little over the budget: the wall, not the budget, bounds the cells).
     let args = [

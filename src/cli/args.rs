@@ -171,13 +171,14 @@ pub enum MeshShape {
 
 #[derive(Debug, Args)]
 pub struct GenerateArgs {
-    /// Target element size [m] (default at order 2: min(D_min/2, D_max/4), coarsened for thin plates and
-    /// bowls, and along long tubes, to about 12 000 tets; at order 1: min(D_min/8, D_max/20);
+    /// Target element size [m] (default at order 2: min(D_min/2, D_max/4), coarsened for thin plates,
+    /// discs and bowls, and along long tubes, to about 12 000 tets; at order 1: min(D_min/8, D_max/20);
     /// docs/scene-format.md). A given size is used in every direction.
     #[arg(long, value_name = "H", allow_negative_numbers = true)]
     pub h: Option<f64>,
-    /// Element order of the written mesh (2 puts curved mid-edge nodes on curved surfaces).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    /// Element order of the written mesh: 2 (the solver's default, with curved mid-edge nodes on
+    /// curved surfaces) or 1 (linear tets, sized for linear elements).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
     /// Output .msh file (Gmsh 4.1 ASCII).
     #[arg(short, long)]
