@@ -328,7 +328,6 @@ impl<'a> Assembly<'a> {
                 self.add_far_panels(region, src, rule, slot, b);
                 continue;
             }
-
             for panel in &self.sources[src.span.clone()] {
                 let (a, op) = self.pair(i, panel, slot_index, g);
                 *slot += a;
@@ -380,6 +379,10 @@ impl<'a> Assembly<'a> {
             OffRule::Centroid => (&self.centroid_points, 1),
             _ => (&self.three_points, 3),
         };
+        debug_assert!(self.sources[src.span.clone()].iter().all(|panel| {
+            let dist = norm(sub(panel.centroid, region.centre));
+            !is_near(region, panel, dist) && self.off_rule(panel, dist) == rule
+        }));
         let range = per_panel * src.span.start..per_panel * src.span.end;
         columns.for_each_coupled(&self.coupled, (region.centre, region.normal), range, |p, a, op| {
             *slot += a;
@@ -547,6 +550,7 @@ impl<'a> Assembly<'a> {
 }
 
 /// How a panel off its near field is integrated ([`Assembly::off_rule`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum OffRule {
     Centroid,
     ThreePoint,
