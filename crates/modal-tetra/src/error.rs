@@ -72,7 +72,11 @@ pub enum TetraError {
         reason: String,
     },
     /// The requested resolution would exceed `TetOptions::max_tets`.
-    #[error("cell size {cell_m:.3e} m would make about {estimated} tets, above the limit of {limit} (raise --cell or the limit)")]
+    #[error(
+        "cell size {cell_m:.3e} m would make about {estimated} tets, above the limit of {limit}: give --cell {:.2e} or \
+         larger (cells much wider than a thin wall lose parts of it; the warnings say where)",
+        cell_within(*cell_m, *estimated, *limit)
+    )]
     TooManyTets {
         /// Cell size that was asked for or derived (m).
         cell_m: f64,
@@ -89,4 +93,11 @@ pub enum TetraError {
         /// What to do: a cell that works, or why none will.
         hint: String,
     },
+}
+
+/// The cell size [m] at which a resolution estimated at `estimated` tets
+/// with cell `cell_m` would hold about `limit`: the count goes as `cell⁻³`
+/// (a lattice of cubes, 12 tets each), plus 1 % for the lattice's rounding.
+fn cell_within(cell_m: f64, estimated: u64, limit: usize) -> f64 {
+    cell_m * (estimated as f64 / limit.max(1) as f64).cbrt() * 1.01
 }

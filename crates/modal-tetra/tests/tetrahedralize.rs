@@ -77,6 +77,14 @@ fn options_control_resolution_and_guard_size() {
     assert!((3000..8000).contains(&target.tets), "{target:?}");
     let err = tetrahedralize(&s, &TetOptions { cell: Some(1e-5), ..Default::default() }).unwrap_err();
     assert!(matches!(err, TetraError::TooManyTets { .. }), "{err}");
+    // The refusal names a cell that passes the same check, near the limit.
+    let capped = TetOptions { cell: Some(0.004), max_tets: 3000, ..Default::default() };
+    let text = tetrahedralize(&s, &capped).unwrap_err().to_string();
+    let suggested: f64 =
+        text.split("--cell ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    assert!(suggested > 0.004, "{text}");
+    let fits = tetrahedralize(&s, &TetOptions { cell: Some(suggested), ..capped }).unwrap().1;
+    assert!(fits.tets > 2000 && fits.tets < 4000, "{} tets at the suggested {suggested}", fits.tets);
     for bad in [0.0, -1.0, f64::NAN] {
         let e = tetrahedralize(&s, &TetOptions { cell: Some(bad), ..Default::default() }).unwrap_err();
         assert!(matches!(e, TetraError::InvalidOption { name: "cell", .. }), "{e}");
