@@ -67,10 +67,10 @@ fn refuse_beyond_memory(
     limit_bytes: Option<u64>,
     what: &str,
 ) -> Result<(), ProviderError> {
-    let Some(limit) = limit_bytes.or_else(modal_eigen::default_memory_limit) else { return Ok(()) };
     if order != 2 {
         return Ok(());
     }
+    let Some(limit) = limit_bytes.or_else(modal_eigen::default_memory_limit) else { return Ok(()) };
     let tets = shape.tet_count(sizes);
     let needed = modal_fem::min_quadratic_matrices_bytes(tets);
     if needed <= limit {

@@ -377,7 +377,8 @@ impl<'a> Assembly<'a> {
     fn add_far_panels(&self, region: &Region, src: &Region, rule: OffRule, slot: &mut c64, b: &mut [c64]) {
         let (columns, per_panel) = match rule {
             OffRule::Centroid => (&self.centroid_points, 1),
-            _ => (&self.three_points, 3),
+            OffRule::ThreePoint => (&self.three_points, 3),
+            OffRule::Adaptive => unreachable!("uniform_far_rule never gives the adaptive rule"),
         };
         debug_assert!(self.sources[src.span.clone()].iter().all(|panel| {
             let dist = norm(sub(panel.centroid, region.centre));
