@@ -77,7 +77,8 @@ pub struct MeshInputArgs {
     /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres).
     #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
     pub scale: f64,
-    /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY).
+    /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY); on a thin
+    /// shell (a wall thinner than the cell / 1.5), the longest tet edge along the wall.
     #[arg(long, value_name = "H")]
     pub cell: Option<f64>,
     /// Object of a multi-object surface file to mesh (default: all, as one body).
@@ -154,7 +155,8 @@ pub enum MeshShape {
         /// Output .msh file (Gmsh 4.1).
         #[arg(short, long)]
         out: PathBuf,
-        /// Lattice cell size [m].
+        /// Lattice cell size [m]; on a thin shell (a wall thinner than the cell / 1.5), the
+        /// longest tet edge along the wall.
         #[arg(long, value_name = "H")]
         cell: Option<f64>,
         /// Multiply all coordinates by S.

@@ -48,6 +48,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
                 "thin_samples": r.thin_samples,
                 "min_thickness_m": r.min_thickness_m,
                 "max_surface_gap_m": r.max_surface_gap_m,
+                "wall_layers": r.wall_layers,
             });
             if json {
                 print_json(&summary)
@@ -65,6 +66,14 @@ pub fn run(shape: MeshShape) -> Result<()> {
                     r.surface_volume_m3,
                     r.max_surface_deviation_m
                 );
+                if r.wall_layers > 0 {
+                    println!(
+                        "thin shell: {} layer(s) of tets across its {:.3e} m wall, edges along it up to {:.3e} m",
+                        r.wall_layers,
+                        r.min_thickness_m.unwrap_or(f64::NAN),
+                        r.cell_m
+                    );
+                }
                 println!("wrote {}", out.display());
                 Ok(())
             }

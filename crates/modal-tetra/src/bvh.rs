@@ -141,6 +141,19 @@ impl Bvh {
 
     /// Parameters t ∈ [0, 1] (sorted) where segment p→q crosses a triangle.
     pub fn crossings(&self, p: V3, q: V3) -> Vec<f64> {
+        let mut hits: Vec<f64> = self.crossings_with_index(p, q).into_iter().map(|(t, _)| t).collect();
+        hits.sort_by(f64::total_cmp);
+        hits
+    }
+
+    /// The first crossing of segment p→q: its parameter t ∈ [0, 1] and the
+    /// input index of the triangle crossed (the lower index on a tie).
+    pub fn first_crossing(&self, p: V3, q: V3) -> Option<(f64, usize)> {
+        self.crossings_with_index(p, q).into_iter().min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+    }
+
+    /// Every crossing of segment p→q with the input index of its triangle, unsorted.
+    fn crossings_with_index(&self, p: V3, q: V3) -> Vec<(f64, usize)> {
         let mut hits = Vec::new();
         if self.nodes.is_empty() {
             return hits;
@@ -154,14 +167,14 @@ impl Bvh {
                 continue;
             }
             if node.count > 0 {
-                for t in &self.tris[node.first..node.first + node.count] {
-                    hits.extend(segment_triangle(p, q, t[0], t[1], t[2]));
+                for k in node.first..node.first + node.count {
+                    let t = &self.tris[k];
+                    hits.extend(segment_triangle(p, q, t[0], t[1], t[2]).map(|s| (s, self.index[k])));
                 }
             } else {
                 stack.extend(node.children);
             }
         }
-        hits.sort_by(f64::total_cmp);
         hits
     }
 }

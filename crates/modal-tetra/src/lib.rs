@@ -29,6 +29,13 @@
 //!    nodes moved to the closest surface point, guarded by a Jacobian check
 //!    with a straight fallback per element ([`MIN_JACOBIAN_RATIO`]).
 //!
+//! Thin shells (module `shell`): when the cell would be at least
+//! [`LAYERED_MIN_CELLS_PER_WALL`] wall thicknesses (2V/A), steps 3–5 are
+//! replaced, if the surface is a shell (paired skins joined at rims), by one
+//! layer of prisms across the wall, three tets each, with edges along the
+//! wall of at most [`LAYERED_CELL_PER_WALL`] thicknesses (or `cell`); a
+//! solid that is no shell (a handle, a thick foot) is stuffed as before.
+//!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
 //! [`TetOptions::target_tets`], else
 //! h = min(max(diagonal / 25, (12 V / 12 000)^⅓), 2V/A / 1.5)
@@ -56,6 +63,7 @@ mod lattice;
 mod mesher;
 mod read;
 pub mod shapes;
+mod shell;
 mod sizing;
 mod stuff;
 mod surface;
@@ -68,7 +76,7 @@ pub use geom::dihedral_angles_deg;
 pub use graded::MAX_LEVELS;
 pub use mesher::{
     tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL, DEFAULT_CELLS_PER_THICKNESS,
-    DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION,
+    DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION, LAYERED_CELL_PER_WALL, LAYERED_MIN_CELLS_PER_WALL,
 };
 pub use read::{parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};

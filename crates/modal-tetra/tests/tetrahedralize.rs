@@ -313,17 +313,24 @@ fn issue_14_corpus_meshes_keep_no_small_hinged_piece_and_pass_the_check() {
 
 #[test]
 fn issue_14_a_thin_solid_falls_back_to_a_finer_cell_or_names_one() {
-    // A 2 mm plate, 10 cm wide: an explicit uniform 8 mm cell finds nothing
-    // inside and names a cell that works; the default cell (thickness-aware) works.
-    let plate = shapes::cuboid(0.1, 0.1, 0.002);
+    // A 2 mm square rod, 10 cm long (no shell: its one skin faces itself): an
+    // explicit uniform 8 mm cell finds nothing inside and names a cell that works.
+    let rod = shapes::cuboid(0.1, 0.002, 0.002);
     let uniform = TetOptions { cell: Some(0.008), graded: false, ..Default::default() };
-    let e = tetrahedralize(&plate, &uniform).unwrap_err();
+    let e = tetrahedralize(&rod, &uniform).unwrap_err();
     let text = e.to_string();
     assert!(matches!(e, TetraError::NoVolume { .. }), "{text}");
     assert!(text.contains("--cell") && text.contains("works"), "{text}");
     let cell: f64 = text.split("--cell ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
-    let (_, r) = tetrahedralize(&plate, &TetOptions { cell: Some(cell), ..uniform.clone() }).unwrap();
-    assert!(r.tets > 0);
+    let (_, r) = tetrahedralize(&rod, &TetOptions { cell: Some(cell), ..uniform.clone() }).unwrap();
+    assert!(r.tets > 0 && r.wall_layers == 0, "{r:?}");
+    // A 2 mm plate 10 cm wide is a shell: the same 8 mm cell gives one layer
+    // of tets across it with edges along it of at most 8 mm.
+    let plate = shapes::cuboid(0.1, 0.1, 0.002);
+    let (m, r) = tetrahedralize(&plate, &uniform).unwrap();
+    assert_good(&m, &r);
+    assert_eq!(r.wall_layers, 1, "{r:?}");
+    assert!(r.cell_m <= 0.008 && rel(r.volume_m3, r.surface_volume_m3).abs() < 1e-9, "{r:?}");
     // Graded, the same bulk cell refines the plate to its thickness.
     let (m, r) =
         tetrahedralize(&plate, &TetOptions { cell: Some(0.008), graded: true, ..Default::default() })
