@@ -77,3 +77,31 @@ fn a_mug_with_a_handle_is_not_a_shell_and_is_stuffed() {
     let (_, report) = tetrahedralize(&surface, &TetOptions { curved: false, ..Default::default() }).unwrap();
     assert_eq!(report.wall_layers, 0, "{report:?}");
 }
+
+/// The error of the layered bowl against the faceting of its input surface
+/// (BENCHMARKS, "Thin shells in layers"): the input's triangles are the
+/// skin's, refined to edges of at most the in-plane size but never coarsened.
+/// `cargo test --release -p modal-tetra --test shell -- --ignored --nocapture`.
+#[test]
+#[ignore = "a 2 mm structured reference bowl: minutes"]
+fn layered_bowl_error_against_input_faceting() {
+    let shape = Shape::Bowl { radius: 0.06, thickness: 0.004 };
+    let reference = frequencies(&generate(&shape, 0.002, 2).unwrap(), 12);
+    println!("reference (structured, 2 mm, 10-node): {reference:.1?}");
+    println!("| input facets mm | longest layered edge mm | tets | worst error | errors % |");
+    for facet in [0.004, 0.006, 0.008, 0.012] {
+        let surface = surface_of(&generate(&shape, facet, 1).unwrap());
+        let (mesh, report) = tetrahedralize(&surface, &TetOptions::default()).unwrap();
+        assert_eq!(report.wall_layers, 1, "{report:?}");
+        let ours = frequencies(&modal_mesh::check(mesh).unwrap().0, 12);
+        let errors: Vec<f64> =
+            ours.iter().zip(&reference).map(|(f, g)| 100.0 * common::rel(*f, *g)).collect();
+        let worst = errors.iter().fold(0.0f64, |a, e| a.max(e.abs()));
+        println!(
+            "| {} | {:.2} | {} | {worst:.2} % | {errors:.2?} |",
+            1e3 * facet,
+            1e3 * report.cell_m,
+            report.tets
+        );
+    }
+}
