@@ -432,7 +432,8 @@ fn try_layered(
         max_tets: options.max_tets,
     };
     let volume_m3 = repaired.report.enclosed_volume_m3;
-    match layered(&repaired.vertices, &repaired.triangles, bvh, diagonal, volume_m3, sizing) {
+    let components = repaired.report.components;
+    match layered(&repaired.vertices, &repaired.triangles, bvh, diagonal, (volume_m3, components), sizing) {
         Ok(l) => Ok(Some(l)),
         Err(NotLayered::TooMany { estimated, in_plane_m }) => {
             // Tets go as cell⁻² here; the error's hint assumes cell⁻³.

@@ -105,3 +105,41 @@ fn layered_bowl_error_against_input_faceting() {
         );
     }
 }
+
+/// Rotates a surface by angles about x, then y, then z [rad].
+fn rotated(mut s: TriSurface, [a, b, c]: [f64; 3]) -> TriSurface {
+    for p in &mut s.vertices {
+        let [x, y, z] = *p;
+        let (y, z) = (y * a.cos() - z * a.sin(), y * a.sin() + z * a.cos());
+        let (x, z) = (x * b.cos() + z * b.sin(), -x * b.sin() + z * b.cos());
+        let (x, y) = (x * c.cos() - y * c.sin(), x * c.sin() + y * c.cos());
+        *p = [x, y, z];
+    }
+    s
+}
+
+#[test]
+fn shells_of_several_shapes_and_orientations_are_layered_and_valid() {
+    // A pipe: an annulus revolved about the axis (no rim on the axis).
+    let pipe =
+        shapes::revolve(&[(0.030, 0.0), (0.032, 0.0), (0.032, 0.2), (0.030, 0.2), (0.030, 0.0)], 48, "pipe");
+    let cases = [
+        ("footed bowl", shapes::bowl(0.08, 0.005, 48)),
+        ("plate", shapes::cuboid(0.15, 0.1, 0.002)),
+        ("pipe", pipe),
+        ("bell", shapes::bell(0.15, 0.08, 0.002, 40)),
+    ];
+    for (name, surface) in cases {
+        for angles in [[0.0, 0.0, 0.0], [0.7, 1.9, 2.3]] {
+            let s = rotated(surface.clone(), angles);
+            let options = TetOptions { curved: false, ..Default::default() };
+            let (mesh, report) = tetrahedralize(&s, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(report.wall_layers, 1, "{name} {angles:?}: {report:?}");
+            let (_, r) = modal_mesh::check(mesh).unwrap();
+            assert_eq!(r.reoriented, 0, "{name}: all tets positively oriented");
+            let volume_error = report.volume_m3 / report.surface_volume_m3 - 1.0;
+            assert!(volume_error.abs() < 0.02, "{name} {angles:?}: volume {volume_error:.4}");
+            println!("{name} {angles:?}: {} tets, volume {:+.4} %", report.tets, 100.0 * volume_error);
+        }
+    }
+}

@@ -330,7 +330,7 @@ fn issue_14_a_thin_solid_falls_back_to_a_finer_cell_or_names_one() {
     let (m, r) = tetrahedralize(&plate, &uniform).unwrap();
     assert_good(&m, &r);
     assert_eq!(r.wall_layers, 1, "{r:?}");
-    assert!(r.cell_m <= 0.008 && rel(r.volume_m3, r.surface_volume_m3).abs() < 1e-9, "{r:?}");
+    assert!(r.cell_m <= 0.008 && rel(r.volume_m3, r.surface_volume_m3).abs() < 1e-6, "{r:?}");
     // Graded, the same bulk cell refines the plate to its thickness.
     let (m, r) =
         tetrahedralize(&plate, &TetOptions { cell: Some(0.008), graded: true, ..Default::default() })
