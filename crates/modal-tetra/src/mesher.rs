@@ -321,7 +321,7 @@ pub fn tetrahedralize(
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
     let bvh = Bvh::new(tris);
     let mut warnings = Vec::new();
-    let layered = try_layered(&repaired, &bvh, options, (diagonal, volume, area))?;
+    let layered = try_layered(&repaired, &bvh, options, (diagonal, volume, area), &mut warnings)?;
     let (mut stuffed, h, thin_samples, min_thickness_m, wall_layers) = match layered {
         Some(l) => {
             let stuffed = Stuffed { nodes: l.nodes, tets: l.tets, dropped: 0, min_cell: l.shortest_edge_m };
@@ -411,6 +411,7 @@ fn try_layered(
     bvh: &Bvh,
     options: &TetOptions,
     (diagonal, volume, area): (f64, f64, f64),
+    warnings: &mut Vec<String>,
 ) -> Result<Option<Layered>, TetraError> {
     if options.graded || options.target_tets.is_some() || !(volume > 0.0 && area > 0.0) {
         return Ok(None);
@@ -444,8 +445,36 @@ fn try_layered(
                 limit: options.max_tets,
             })
         }
-        Err(_) => Ok(None),
+        Err(reason) => {
+            warnings.push(not_layered_warning(&reason, wall));
+            Ok(None)
+        }
     }
+}
+
+/// Why a thin-walled solid was stuffed with cells of its wall's size instead
+/// of meshed in layers (slower, and a warning says so).
+fn not_layered_warning(reason: &NotLayered, wall: f64) -> String {
+    let why = match reason {
+        NotLayered::Unpaired { paired_fraction } => {
+            format!("only {:.0} % of its surface lies in walls with a facing side", 100.0 * paired_fraction)
+        }
+        NotLayered::Skins => {
+            "it is no shell (a part faces itself, like a handle or a rod, or its walls' sides do not pair up)"
+                .into()
+        }
+        NotLayered::Column { at } | NotLayered::Fold { at } => {
+            format!("layers across its wall would fold near ({:.4}, {:.4}, {:.4}) m", at[0], at[1], at[2])
+        }
+        NotLayered::Volume { ratio } => {
+            format!("its walls hold only {:.1} % of its volume (a thick part)", 100.0 * ratio)
+        }
+        NotLayered::TooMany { .. } => "it needs too many layered tets".into(),
+    };
+    format!(
+        "thin walls (mean thickness 2V/A = {wall:.3e} m), not meshed in layers across the wall: {why}; \
+         filled with cells of the wall's size instead (more tets, slower)"
+    )
 }
 
 /// The uniform (or graded) isosurface stuffing of the surface at cell `h0`,

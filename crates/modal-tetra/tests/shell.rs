@@ -76,6 +76,9 @@ fn a_mug_with_a_handle_is_not_a_shell_and_is_stuffed() {
     let surface = shapes::mug(0.04, 0.09, 0.004, 48);
     let (_, report) = tetrahedralize(&surface, &TetOptions { curved: false, ..Default::default() }).unwrap();
     assert_eq!(report.wall_layers, 0, "{report:?}");
+    // It says why it was filled with cells of the wall's size (the slow path).
+    let why = report.warnings.iter().find(|w| w.contains("not meshed in layers"));
+    assert!(why.is_some_and(|w| w.contains("no shell") && !w.contains('\n')), "{:?}", report.warnings);
 }
 
 /// The error of the layered bowl against the faceting of its input surface
