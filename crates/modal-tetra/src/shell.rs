@@ -359,7 +359,7 @@ fn max_wall(pairs: &[Pair]) -> f64 {
 }
 
 /// The master skin as its own triangle mesh: vertex positions, triangles
-/// (outward, counter-clockwise) and, per triangle, the input triangle it lies in.
+/// (outward, counter-clockwise).
 struct Skin {
     vertices: Vec<V3>,
     triangles: Vec<[usize; 3]>,
@@ -456,7 +456,7 @@ impl Skin {
     }
 
     /// Step 4: where each vertex's column ends on the opposite skins, within
-    /// `reach`, by one of two [`Columns`] rules; `None` where a ray finds nothing.
+    /// `reach`, by one of two [`Columns`] rules; [`NotLayered::Column`] where none is found.
     fn column_ends(
         &self,
         opposite: &Bvh,
