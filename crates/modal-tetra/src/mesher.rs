@@ -417,12 +417,7 @@ fn try_layered(
         return Ok(None);
     }
     let wall = 2.0 * volume / area;
-    let bulk = (diagonal / options.cells_per_diagonal).max(if options.default_max_tets < usize::MAX {
-        (12.0 * volume / options.default_max_tets.max(1) as f64).cbrt()
-    } else {
-        0.0
-    });
-    let size = options.cell.unwrap_or(bulk) * options.size_factor;
+    let size = options.cell.unwrap_or_else(|| bulk_cell(options, diagonal, volume)) * options.size_factor;
     if size.is_nan() || size < LAYERED_MIN_CELLS_PER_WALL * wall {
         return Ok(None);
     }
@@ -603,14 +598,22 @@ fn base_cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -
     }
     positive("cells_per_diagonal", options.cells_per_diagonal)?;
     positive("cells_per_thickness", options.cells_per_thickness)?;
-    let mut h = diagonal / options.cells_per_diagonal;
-    if volume > 0.0 && options.default_max_tets > 0 && options.default_max_tets < usize::MAX {
-        h = h.max((12.0 * volume / options.default_max_tets as f64).cbrt());
-    }
+    let mut h = bulk_cell(options, diagonal, volume);
     if !options.graded && volume > 0.0 && area > 0.0 {
         h = h.min(2.0 * volume / area / options.cells_per_thickness);
     }
     positive("cell", h)
+}
+
+/// The default cell before the thickness bound: diagonal / `cells_per_diagonal`,
+/// coarsened until the solid holds about `default_max_tets` tets (0 or `usize::MAX`: no cap).
+fn bulk_cell(options: &TetOptions, diagonal: f64, volume: f64) -> f64 {
+    let h = diagonal / options.cells_per_diagonal;
+    if volume > 0.0 && options.default_max_tets > 0 && options.default_max_tets < usize::MAX {
+        h.max((12.0 * volume / options.default_max_tets as f64).cbrt())
+    } else {
+        h
+    }
 }
 
 /// Halvings of the cell tried when the first cell gives no tets.

@@ -44,6 +44,7 @@ use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, V3};
+use crate::stuff::edge;
 
 /// Walls up to this fraction of the bounding-box diagonal can pair.
 pub const MAX_WALL_FRACTION: f64 = 0.1;
@@ -51,7 +52,7 @@ pub const MAX_WALL_FRACTION: f64 = 0.1;
 /// Paired skins must hold at least this fraction of the surface area.
 pub const MIN_PAIRED_AREA: f64 = 0.8;
 
-/// A skin's partner must receive at least this fraction (by area) of its rays.
+/// Each skin must send at least this fraction (by area) of its rays to the other side.
 pub const MIN_PARTNER_SHARE: f64 = 0.8;
 
 /// Each tet keeps at least this fraction of its ideal-prism volume.
@@ -203,8 +204,8 @@ fn pair_triangles(vertices: &[V3], triangles: &[[usize; 3]], bvh: &Bvh, diagonal
         .collect()
 }
 
-/// Step 2: the master triangles (the larger skin of each pair) and the
-/// others of the paired skins, or why there are none.
+/// Step 2: the master triangles (the master side of each group of facing
+/// skins, [`master_sides`]) and the others of the paired skins, or why there are none.
 fn master_triangles(
     triangles: &[[usize; 3]],
     pairs: &[Pair],
@@ -308,7 +309,7 @@ fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usi
     for (t, tri) in triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            by_edge.entry((a.min(b), a.max(b))).or_default().push(t);
+            by_edge.entry(edge(a, b)).or_default().push(t);
         }
     }
     let mut skin_of: Vec<Option<usize>> = vec![None; triangles.len()];
@@ -322,7 +323,7 @@ fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usi
         while let Some(t) = stack.pop() {
             for k in 0..3 {
                 let (a, b) = (triangles[t][k], triangles[t][(k + 1) % 3]);
-                let shared = &by_edge[&(a.min(b), a.max(b))];
+                let shared = &by_edge[&edge(a, b)];
                 if shared.len() != 2 {
                     continue;
                 }
@@ -418,9 +419,7 @@ impl Skin {
             loop {
                 let before = marked.len();
                 for (t, &l) in self.triangles.iter().zip(&longest) {
-                    if !marked.contains(&l)
-                        && (0..3).any(|k| marked.contains(&edge_key(t[k], t[(k + 1) % 3])))
-                    {
+                    if !marked.contains(&l) && (0..3).any(|k| marked.contains(&edge(t[k], t[(k + 1) % 3]))) {
                         marked.insert(l);
                     }
                 }
@@ -433,7 +432,7 @@ impl Skin {
                 self.vertices.push(scale(add(self.vertices[a], self.vertices[b]), 0.5));
                 mid.insert((a, b), self.vertices.len() - 1);
             }
-            let split = |a: usize, b: usize| mid.get(&edge_key(a, b)).copied();
+            let split = |a: usize, b: usize| mid.get(&edge(a, b)).copied();
             let mut next = Vec::with_capacity(2 * self.triangles.len());
             for (&t, &l) in self.triangles.iter().zip(&longest) {
                 bisect(t, l, &split, &mut next);
@@ -449,7 +448,7 @@ impl Skin {
     /// The longest edge of `t` as a sorted key (ties: the smaller key).
     fn longest_edge_of(&self, t: [usize; 3]) -> (usize, usize) {
         (0..3)
-            .map(|k| edge_key(t[k], t[(k + 1) % 3]))
+            .map(|k| edge(t[k], t[(k + 1) % 3]))
             .map(|e| (norm(sub(self.vertices[e.0], self.vertices[e.1])), e))
             .min_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)))
             .map_or((t[0], t[1]), |(_, e)| e)
@@ -481,7 +480,8 @@ impl Skin {
     }
 
     /// Unit normal at each vertex: the area-weighted normal of the skin's
-    /// triangles with a corner within `radius` (a wall thickness) of it. Over
+    /// triangles whose bounding boxes meet the cube of half-side `radius` (a
+    /// wall thickness) about it. Over
     /// the vertex's own triangles alone, a refined sliver beside a facet edge
     /// of a faceted cylinder takes its facet's normal while the edge's vertex
     /// takes the mean of two facets, and across a 2 mm wall their columns
@@ -518,9 +518,10 @@ impl Skin {
             .par_iter()
             .map(|&t| {
                 let mut out = Vec::with_capacity(3 * layers);
+                let column = self.ideal_column(t, ends, layers);
                 for k in 0..layers {
                     for tet in split_prism(t, k, per) {
-                        out.push(self.oriented(tet, t, &nodes, ends, per)?);
+                        out.push(self.oriented(tet, (column, self.vertices[t[0]]), &nodes, per)?);
                     }
                 }
                 Ok(out)
@@ -529,34 +530,32 @@ impl Skin {
         Ok(Prisms { nodes, tets: tets?.into_iter().flatten().collect() })
     }
 
-    /// `tet` (of the prism on triangle `t`) positively oriented, if it keeps
-    /// the sign and at least [`MIN_VOLUME_RATIO`] of its volume in the ideal
-    /// prism (columns along the triangle's own normal, each as long as the
-    /// mean of its three columns).
+    /// The step of one layer along the ideal column of triangle `t`: its own
+    /// normal, inwards, as long as the mean of its three columns / `layers`.
+    fn ideal_column(&self, t: [usize; 3], ends: &[V3], layers: usize) -> V3 {
+        let length = t.iter().map(|&c| norm(sub(ends[c], self.vertices[c]))).sum::<f64>() / 3.0;
+        let normal = unit(area_vector(self.vertices[t[0]], self.vertices[t[1]], self.vertices[t[2]]));
+        scale(normal, -length / layers as f64)
+    }
+
+    /// `tet` (of a prism whose ideal layer step is `step`, first corner
+    /// `corner`) positively oriented, if it keeps the sign and at least
+    /// [`MIN_VOLUME_RATIO`] of its volume in the ideal prism (every column along `step`).
     fn oriented(
         &self,
         tet: [usize; 4],
-        t: [usize; 3],
+        (step, corner): (V3, V3),
         nodes: &[V3],
-        ends: &[V3],
         per: usize,
     ) -> Result<[usize; 4], NotLayered> {
-        let layers = (per - 1) as f64;
-        let length = t.iter().map(|&c| norm(sub(ends[c], self.vertices[c]))).sum::<f64>() / 3.0;
-        let normal = unit(area_vector(self.vertices[t[0]], self.vertices[t[1]], self.vertices[t[2]]));
-        let ideal: [V3; 4] =
-            tet.map(|n| sub(self.vertices[n / per], scale(normal, length * (n % per) as f64 / layers)));
+        let ideal: [V3; 4] = tet.map(|n| add(self.vertices[n / per], scale(step, (n % per) as f64)));
         let expected = orient6(ideal[0], ideal[1], ideal[2], ideal[3]);
         let actual = orient6(nodes[tet[0]], nodes[tet[1]], nodes[tet[2]], nodes[tet[3]]);
         if expected == 0.0 || actual * expected.signum() < MIN_VOLUME_RATIO * expected.abs() {
-            return Err(NotLayered::Fold { at: self.vertices[t[0]] });
+            return Err(NotLayered::Fold { at: corner });
         }
         Ok(if expected > 0.0 { tet } else { [tet[0], tet[1], tet[3], tet[2]] })
     }
-}
-
-fn edge_key(a: usize, b: usize) -> (usize, usize) {
-    (a.min(b), a.max(b))
 }
 
 /// Appends the pieces of triangle `t` (longest edge `longest`) after
@@ -574,7 +573,7 @@ fn bisect(
         return;
     };
     // Rotate so the longest edge is (a, b).
-    let k = (0..3).find(|&k| edge_key(t[k], t[(k + 1) % 3]) == longest).unwrap_or(0);
+    let k = (0..3).find(|&k| edge(t[k], t[(k + 1) % 3]) == longest).unwrap_or(0);
     let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
     match split(c, a) {
         Some(ca) => out.extend([[a, m, ca], [m, c, ca]]),

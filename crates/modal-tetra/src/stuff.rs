@@ -49,7 +49,8 @@ pub(crate) struct Stuffed {
 
 type Edge = (usize, usize);
 
-fn edge(a: usize, b: usize) -> Edge {
+/// An edge as its sorted pair of vertices (the key both its faces share).
+pub(crate) fn edge(a: usize, b: usize) -> Edge {
     (a.min(b), a.max(b))
 }
 
