@@ -38,7 +38,7 @@
 //! height `t/2` below its walls' ends is not meshed: it moves the rim by at
 //! most `t/2`).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use rayon::prelude::*;
 
@@ -215,7 +215,7 @@ fn master_triangles(
     let skins = skin_of.iter().flatten().map(|&s| s + 1).max().unwrap_or(0);
     // Area of each skin and, per skin, the area its rays send to each other skin.
     let mut area = vec![0.0; skins];
-    let mut sent: Vec<HashMap<usize, f64>> = vec![HashMap::new(); skins];
+    let mut sent: Vec<BTreeMap<usize, f64>> = vec![BTreeMap::new(); skins];
     for (t, p) in pairs.iter().enumerate() {
         let (Some(s), Some(j)) = (skin_of[t], p.partner) else { continue };
         area[s] += p.area;
@@ -237,7 +237,7 @@ fn master_triangles(
 /// `components`: two groups in one closed surface would be two bodies.
 fn master_sides(
     area: &[f64],
-    sent: &[HashMap<usize, f64>],
+    sent: &[BTreeMap<usize, f64>],
     components: usize,
 ) -> Result<Vec<bool>, NotLayered> {
     let skins = area.len();
@@ -427,6 +427,10 @@ impl Skin {
                     break;
                 }
             }
+            // Midpoints numbered in edge order: the hash set's order differs
+            // from run to run, and so did the output mesh's node numbering.
+            let mut marked: Vec<(usize, usize)> = marked.into_iter().collect();
+            marked.sort_unstable();
             let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
             for &(a, b) in &marked {
                 self.vertices.push(scale(add(self.vertices[a], self.vertices[b]), 0.5));

@@ -65,6 +65,10 @@ fn a_bell_is_meshed_in_layers_at_defaults() {
     assert_eq!(report.wall_layers, 1, "{report:?}");
     assert!(report.tets < 200_000, "{}", report.tets);
     assert!((report.volume_m3 / report.surface_volume_m3 - 1.0).abs() < 0.01, "{report:?}");
+    // The same input gives the same mesh, node for node (the refinement once
+    // numbered its midpoints in hash-set order).
+    let (again, _) = tetrahedralize(&surface, &TetOptions { curved: false, ..Default::default() }).unwrap();
+    assert!(again.nodes == mesh.nodes && again.cells == mesh.cells, "the layered mesh differs between runs");
     let (_, r) = modal_mesh::check(mesh).unwrap();
     assert_eq!(r.reoriented, 0, "all tets positively oriented");
     assert!(report.max_surface_gap_m < 0.01 * report.cell_m.max(1e-3) * 10.0, "{report:?}");
