@@ -33,8 +33,10 @@
 //! [`LAYERED_MIN_CELLS_PER_WALL`] wall thicknesses (2V/A), steps 3–5 are
 //! replaced, if the surface is a shell (paired skins joined at rims), by one
 //! layer of prisms across the wall, three tets each, with edges along the
-//! wall of at most [`LAYERED_CELL_PER_WALL`] thicknesses (or `cell`); a
-//! solid that is no shell (a handle, a thick foot) is stuffed as before.
+//! wall of at most [`LAYERED_CELL_PER_WALL`] thicknesses (or `cell`), up to
+//! [`LAYERED_STRAIGHT_CELL_PER_WALL`] along directions in which a wall
+//! curved across them is straight (a chime's axis); a solid that is no
+//! shell (a handle, a thick foot) is stuffed as before.
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
 //! [`TetOptions::target_tets`], else
@@ -77,6 +79,7 @@ pub use graded::MAX_LEVELS;
 pub use mesher::{
     tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL, DEFAULT_CELLS_PER_THICKNESS,
     DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION, LAYERED_CELL_PER_WALL, LAYERED_MIN_CELLS_PER_WALL,
+    LAYERED_STRAIGHT_CELL_PER_WALL,
 };
 pub use read::{parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};

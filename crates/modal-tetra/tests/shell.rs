@@ -113,6 +113,36 @@ fn layered_bowl_error_against_input_faceting() {
     }
 }
 
+#[test]
+fn a_chime_keeps_long_cells_along_its_axis_and_rings_like_the_structured_tube() {
+    // A 30 cm chime, 15 mm radius, 1.5 mm wall, faceted as a user's OBJ
+    // would be: 48 segments around, rows 20 mm long. Edges of two walls
+    // everywhere (the curved-wall rule) would give ≈ 10× the tets; along
+    // the straight axis the cells may reach 16 walls. Reference: the
+    // generator's structured tube at 2 mm in every direction.
+    let (inner, outer, length, rows) = (0.0135, 0.015, 0.3, 15);
+    let mut profile: Vec<(f64, f64)> = vec![(inner, 0.0)];
+    profile.extend((0..=rows).map(|i| (outer, length * i as f64 / rows as f64)));
+    profile.extend((0..=rows).rev().map(|i| (inner, length * i as f64 / rows as f64)));
+    let surface = shapes::revolve(&profile, 48, "chime");
+    let (mesh, report) = tetrahedralize(&surface, &TetOptions::default()).unwrap();
+    assert_eq!(report.wall_layers, 1, "{report:?}");
+    assert!(report.cell_m > 4.0 * (outer - inner), "axial edges kept long: {report:?}");
+    assert!((report.volume_m3 / report.surface_volume_m3 - 1.0).abs() < 0.01, "{report:?}");
+    let (checked, r) = modal_mesh::check(mesh).unwrap();
+    assert_eq!(r.reoriented, 0, "all tets positively oriented");
+    let shape = Shape::Tube { inner_radius: inner, outer_radius: outer, length };
+    let (ours, want) = (frequencies(&checked, 10), frequencies(&generate(&shape, 0.002, 2).unwrap(), 10));
+    let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+    println!(
+        "{} layered tets (longest edge {:.1} mm), worst |f/f_ref − 1| over 10 modes: {:.3} %\nours {ours:.1?}\nref  {want:.1?}",
+        report.tets,
+        1e3 * report.cell_m,
+        100.0 * worst
+    );
+    assert!(worst < 0.005, "worst {:.3} %", 100.0 * worst);
+}
+
 /// Rotates a surface by angles about x, then y, then z [rad].
 fn rotated(mut s: TriSurface, [a, b, c]: [f64; 3]) -> TriSurface {
     for p in &mut s.vertices {
