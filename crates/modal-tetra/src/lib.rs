@@ -34,8 +34,8 @@
 //! replaced, if the surface is a shell (paired skins joined at rims), by one
 //! layer of prisms across the wall, three tets each, with edges along the
 //! wall of at most [`LAYERED_CELL_PER_WALL`] thicknesses (or `cell`), up to
-//! [`LAYERED_STRAIGHT_CELL_PER_WALL`] along directions in which a wall
-//! curved across them is straight (a chime's axis); a solid that is no
+//! [`LAYERED_STRAIGHT_CELL_PER_WALL`] along directions in which the wall of
+//! a slender shell, curved across them, is straight (a chime's axis); a solid that is no
 //! shell (a handle, a thick foot) is stuffed as before.
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else

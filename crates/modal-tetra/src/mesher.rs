@@ -404,8 +404,8 @@ pub const LAYERED_MIN_CELLS_PER_WALL: f64 = 1.5;
 /// measured 0.12 % at 2 on a 10 cm glass bowl with a 2 mm wall).
 pub const LAYERED_CELL_PER_WALL: f64 = 2.0;
 
-/// Edges along a layered wall that is straight along them and curved
-/// across them (a pipe's or a chime's axis), in wall thicknesses, by
+/// Edges along a layered wall of a slender shell that is straight along
+/// them and curved across them (a chime's axis), in wall thicknesses, by
 /// default: the generated tubes' axial cell (`modal_mesh`: at most 16 walls
 /// along a long tube's axis; a 1 m chime within 0.42 % of 3 mm cells).
 pub const LAYERED_STRAIGHT_CELL_PER_WALL: f64 = 16.0;
