@@ -92,6 +92,32 @@ fn bar_estimate_brackets_the_converged_table() {
 }
 
 #[test]
+fn a_slender_chime_gets_a_coarser_second_level_and_every_mode_an_estimate() {
+    // A 20 cm chime (15 mm radius, 1.5 mm wall) as a user's OBJ: meshed in layers with
+    // long cells along its axis. The estimate's second level scales every default size
+    // by 1.5; an explicit cell 1.5× the longest edge (as a stuffed solid's level gets)
+    // made both levels the same mesh and every estimate unknown.
+    let dir = temp_dir();
+    let (inner, outer, length, rows) = (0.0135, 0.015, 0.2, 10);
+    let mut profile: Vec<(f64, f64)> = vec![(inner, 0.0)];
+    profile.extend((0..=rows).map(|i| (outer, length * i as f64 / rows as f64)));
+    profile.extend((0..=rows).rev().map(|i| (inner, length * i as f64 / rows as f64)));
+    let obj = write_surface(dir.path(), "chime.obj", &shapes::revolve(&profile, 48, "chime"));
+    let (report, stderr) = precompute(dir.path(), &obj, &["--modes", "6", "--accuracy", "5"]);
+    let method = report["error_estimate_method"].as_str().unwrap_or_default();
+    let dofs: Vec<f64> = method
+        .split(" DOF")
+        .next()
+        .and_then(|s| s.split(": ").nth(1))
+        .map(|s| s.split(" and ").filter_map(|d| d.parse().ok()).collect())
+        .unwrap_or_default();
+    assert!(dofs.len() == 2 && dofs[0] > 2.0 * dofs[1], "levels not distinct: {method}\n{stderr}");
+    let got = modes(&report);
+    assert_eq!(got.len(), 6, "{stderr}");
+    assert!(got.iter().all(|(_, e)| e.is_some_and(|e| e > 0.0 && e < 5.0)), "{got:?}\n{stderr}");
+}
+
+#[test]
 fn tet_mesh_files_get_no_estimate_and_say_why() {
     let dir = temp_dir();
     let msh = dir.path().join("box.msh");

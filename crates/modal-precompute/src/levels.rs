@@ -34,6 +34,7 @@
 use modal_bank::ModeBank;
 
 use crate::accuracy::{estimate, LevelEstimate, ASSUMED_ORDER};
+use crate::load::LevelSize;
 use crate::pipeline::{assemble_and_analyze, solve_bank};
 use crate::{is_surface_file, MeshSource, PrecomputeError, Request, Stage};
 
@@ -103,26 +104,34 @@ struct Level {
     seconds: f64,
     /// The tetrahedralizer's cell of this level [m].
     cell_m: f64,
+    /// Meshed in layers across a thin wall.
+    layered: bool,
     warnings: Vec<String>,
 }
 
-/// Solves level `index`: the request's own discretization for `base_cell = None`,
-/// else the tetrahedralizer's cell `base_cell × size_factor` (its whole sizing field
-/// scales with the cell).
+/// Solves level `index`: the request's own discretization for `base = None`,
+/// else the finest level's size `base` scaled by `size_factor` (a stuffed
+/// solid's cell, whose whole sizing field scales with it, or a layered
+/// shell's default sizes).
 fn solve_level(
     wide: &Request,
     index: usize,
-    base_cell: Option<f64>,
+    base: Option<LevelSize>,
     size_factor: f64,
     key: &str,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Level, PrecomputeError> {
     progress(Stage::Level { index, size_factor });
     let start = std::time::Instant::now();
-    let level_cell = base_cell.map(|c| c * size_factor);
-    let (assembled, analysis) = assemble_and_analyze(wide, true, level_cell, progress)?;
+    let level = base.map(|b| b.scaled(size_factor));
+    let (assembled, analysis) = assemble_and_analyze(wide, true, level, progress)?;
     let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
+    let level_cell = match level {
+        Some(LevelSize::Cell(c)) => Some(c),
+        _ => None,
+    };
     let cell_m = assembled.cell_m.or(level_cell).unwrap_or(f64::NAN);
+    let layered = assembled.layered;
     let seconds = start.elapsed().as_secs_f64();
     Ok(Level {
         dofs: bank.info.dofs,
@@ -131,6 +140,7 @@ fn solve_level(
         size_factor,
         seconds,
         cell_m,
+        layered,
         warnings: assembled.warnings,
     })
 }
@@ -156,7 +166,11 @@ pub(crate) fn solve_to_accuracy(
     let mut warnings = Vec::new();
     let mut fine = solve_level(&wide, 0, None, 1.0, key, progress)?;
     warnings.append(&mut fine.warnings);
-    let base_cell = Some(fine.cell_m).filter(|c| c.is_finite() && *c > 0.0);
+    let base_cell = if fine.layered {
+        Some(LevelSize::Factor(1.0))
+    } else {
+        Some(fine.cell_m).filter(|c| c.is_finite() && *c > 0.0).map(LevelSize::Cell)
+    };
     let mut coarse = match solve_level(&wide, 1, base_cell, COARSE_FACTOR, key, progress) {
         Ok(level) => level,
         Err(err) => {

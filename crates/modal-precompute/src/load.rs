@@ -51,6 +51,30 @@ pub struct LoadedMesh {
     /// The tetrahedralizer's cell size [m] (`TetReport::cell_m`) for a surface
     /// mesh; `None` for a tet mesh.
     pub cell_m: Option<f64>,
+    /// The surface was meshed in layers across a thin wall (`TetReport::wall_layers` > 0).
+    pub layered: bool,
+}
+
+/// How a discretization level (`crate::levels`) sizes a surface mesh's tets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum LevelSize {
+    /// The tetrahedralizer's cell [m]: a stuffed solid's whole sizing field scales with it.
+    Cell(f64),
+    /// Every default size times this factor (`TetOptions::size_factor`): a thin
+    /// shell meshed in layers, whose edges along a slender wall's axis are
+    /// longer than around it (an explicit cell would make them one size, and
+    /// the coarser level of a chime the same mesh as the finer).
+    Factor(f64),
+}
+
+impl LevelSize {
+    /// This level's size scaled by `factor`.
+    pub(crate) fn scaled(self, factor: f64) -> LevelSize {
+        match self {
+            LevelSize::Cell(c) => LevelSize::Cell(c * factor),
+            LevelSize::Factor(f) => LevelSize::Factor(f * factor),
+        }
+    }
 }
 
 /// True for file types that hold a surface to be tetrahedralized.
@@ -68,31 +92,33 @@ pub fn load_mesh(
     load_mesh_sized(source, scale, surface, None)
 }
 
-/// [`load_mesh`] with the tetrahedralizer's cell of a surface mesh set to
-/// `level_cell` when given (the discretization levels of `crate::levels`: the
-/// mesher's whole sizing field scales with its cell). Tet meshes are not touched.
+/// [`load_mesh`] with a surface mesh's tets sized by `level` when given (the
+/// discretization levels of `crate::levels`). Tet meshes are not touched.
 pub(crate) fn load_mesh_sized(
     source: &MeshSource,
     scale: f64,
     surface: &SurfaceMeshing,
-    level_cell: Option<f64>,
+    level: Option<LevelSize>,
 ) -> Result<LoadedMesh, PrecomputeError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
     }
     let mut warnings = Vec::new();
-    let mut cell_m = None;
+    let (mut cell_m, mut layered) = (None, false);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
             warnings.extend(report.warnings.iter().cloned());
             let mut options = surface.tet_options();
-            if level_cell.is_some() {
-                options.cell = level_cell;
+            match level {
+                Some(LevelSize::Cell(c)) => options.cell = Some(c),
+                Some(LevelSize::Factor(f)) => options.size_factor = f,
+                None => {}
             }
             let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &options)?;
             warnings.extend(tet_report.warnings);
             cell_m = Some(tet_report.cell_m);
+            layered = tet_report.wall_layers > 0;
             mesh
         }
         MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,
@@ -105,5 +131,5 @@ pub(crate) fn load_mesh_sized(
     let (mesh, report) = modal_mesh::check(raw)?;
     warnings.extend(report.warnings.iter().cloned());
     let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
-    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m })
+    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered })
 }

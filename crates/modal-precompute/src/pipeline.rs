@@ -10,7 +10,7 @@ use modal_fem::Material;
 use modal_mesh::TetMesh;
 
 use crate::levels::AccuracyTarget;
-use crate::load::{load_mesh_sized, SurfaceMeshing};
+use crate::load::{load_mesh_sized, LevelSize, SurfaceMeshing};
 use crate::{cache_key, MeshSource, PrecomputeError};
 
 /// What to compute. `Default` gives the CLI's defaults for everything but
@@ -155,6 +155,8 @@ pub struct Assembled {
     pub warnings: Vec<String>,
     /// The tetrahedralizer's cell size [m] for a surface mesh (`None`: tet mesh).
     pub cell_m: Option<f64>,
+    /// The surface was meshed in layers across a thin wall.
+    pub layered: bool,
 }
 
 /// Loads the mesh and assembles K and M (what `export-matrices` writes).
@@ -169,17 +171,17 @@ pub fn assemble_matrices(
 /// solved) the eigensolver's ordering and symbolic factorization beside the numeric
 /// assembly: they depend on the pattern only, and the second core is partly idle while the
 /// element matrices are scattered (30k DOF: ≈ 0.14 s of ordering and analysis hidden).
-/// `assemble_s` is the wall time of both. `level_cell` sets the tetrahedralizer's cell
-/// of a surface mesh (see [`load_mesh_sized`]).
+/// `assemble_s` is the wall time of both. `level` sizes a surface mesh's tets (see
+/// [`load_mesh_sized`]).
 pub(crate) fn assemble_and_analyze(
     request: &Request,
     analyze: bool,
-    level_cell: Option<f64>,
+    level: Option<LevelSize>,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<(Assembled, Option<modal_eigen::Analysis>), PrecomputeError> {
     request.validate()?;
     progress(Stage::Load);
-    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level_cell)?;
+    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
@@ -207,6 +209,7 @@ pub(crate) fn assemble_and_analyze(
         assemble_s: start.elapsed().as_secs_f64(),
         warnings: loaded.warnings,
         cell_m: loaded.cell_m,
+        layered: loaded.layered,
     };
     Ok((assembled, analysis))
 }

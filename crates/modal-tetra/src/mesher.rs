@@ -431,6 +431,7 @@ fn try_layered(
         in_plane_m: options.cell.map(|c| c * options.size_factor),
         wall_cells: LAYERED_CELL_PER_WALL * options.size_factor,
         straight_wall_cells: LAYERED_STRAIGHT_CELL_PER_WALL * options.size_factor,
+        size_factor: options.size_factor,
         max_in_plane_m: size,
         max_tets: options.max_tets,
     };

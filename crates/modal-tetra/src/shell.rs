@@ -128,6 +128,8 @@ pub(crate) struct LayerSizing {
     /// Edges along a wall straight along them and curved across (a pipe's
     /// axis) in wall thicknesses when `in_plane_m` is `None`.
     pub straight_wall_cells: f64,
+    /// The factor every default size is scaled by (`TetOptions::size_factor`).
+    pub size_factor: f64,
     /// Upper bound of the in-plane edge when it follows the wall [m].
     pub max_in_plane_m: f64,
     /// Refuse (as [`NotLayered::TooMany`]) beyond this many tets.
@@ -245,7 +247,7 @@ impl EdgeLimits {
         let curved_m = sizing.in_plane_m.unwrap_or((sizing.wall_cells * wall_m).min(sizing.max_in_plane_m));
         let straight_m = match (sizing.in_plane_m, slender) {
             (None, Some(length)) => (sizing.straight_wall_cells * wall_m)
-                .min(length / SLENDER_CELLS_PER_LENGTH)
+                .min(length / SLENDER_CELLS_PER_LENGTH * sizing.size_factor)
                 .min(sizing.max_in_plane_m)
                 .max(curved_m),
             _ => curved_m,
