@@ -98,11 +98,7 @@ fn a_slender_chime_gets_a_coarser_second_level_and_every_mode_an_estimate() {
     // by 1.5; an explicit cell 1.5× the longest edge (as a stuffed solid's level gets)
     // made both levels the same mesh and every estimate unknown.
     let dir = temp_dir();
-    let (inner, outer, length, rows) = (0.0135, 0.015, 0.2, 10);
-    let mut profile: Vec<(f64, f64)> = vec![(inner, 0.0)];
-    profile.extend((0..=rows).map(|i| (outer, length * i as f64 / rows as f64)));
-    profile.extend((0..=rows).rev().map(|i| (inner, length * i as f64 / rows as f64)));
-    let obj = write_surface(dir.path(), "chime.obj", &shapes::revolve(&profile, 48, "chime"));
+    let obj = write_surface(dir.path(), "chime.obj", &shapes::tube(0.0135, 0.015, 0.2, 10, 48));
     let (report, stderr) = precompute(dir.path(), &obj, &["--modes", "6", "--accuracy", "5"]);
     let method = report["error_estimate_method"].as_str().unwrap_or_default();
     let dofs: Vec<f64> = method

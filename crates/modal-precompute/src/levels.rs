@@ -131,7 +131,6 @@ fn solve_level(
         _ => None,
     };
     let cell_m = assembled.cell_m.or(level_cell).unwrap_or(f64::NAN);
-    let layered = assembled.layered;
     let seconds = start.elapsed().as_secs_f64();
     Ok(Level {
         dofs: bank.info.dofs,
@@ -140,7 +139,7 @@ fn solve_level(
         size_factor,
         seconds,
         cell_m,
-        layered,
+        layered: assembled.layered,
         warnings: assembled.warnings,
     })
 }
@@ -166,12 +165,12 @@ pub(crate) fn solve_to_accuracy(
     let mut warnings = Vec::new();
     let mut fine = solve_level(&wide, 0, None, 1.0, key, progress)?;
     warnings.append(&mut fine.warnings);
-    let base_cell = if fine.layered {
+    let base = if fine.layered {
         Some(LevelSize::Factor(1.0))
     } else {
         Some(fine.cell_m).filter(|c| c.is_finite() && *c > 0.0).map(LevelSize::Cell)
     };
-    let mut coarse = match solve_level(&wide, 1, base_cell, COARSE_FACTOR, key, progress) {
+    let mut coarse = match solve_level(&wide, 1, base, COARSE_FACTOR, key, progress) {
         Ok(level) => level,
         Err(err) => {
             warnings.push(format!(
@@ -185,7 +184,7 @@ pub(crate) fn solve_to_accuracy(
     let parts = |level: &Level| level.bank.info.rigid_modes_removed;
     if parts(&coarse) != parts(&fine) {
         // Another object (see the module docs): a milder coarsening, if it keeps the parts.
-        match solve_level(&wide, 1, base_cell, MILD_COARSE_FACTOR, key, progress) {
+        match solve_level(&wide, 1, base, MILD_COARSE_FACTOR, key, progress) {
             Ok(mild) => {
                 spent += mild.seconds;
                 match mild_outcome(parts(&fine), Ok(parts(&mild))) {
@@ -238,7 +237,7 @@ pub(crate) fn solve_to_accuracy(
             warnings.push(format!("{reached} ({} DOF): {why}", fine.dofs));
             return Ok((bank, warnings));
         }
-        match solve_level(&wide, refinement + 2, base_cell, fine.size_factor * step, key, progress) {
+        match solve_level(&wide, refinement + 2, base, fine.size_factor * step, key, progress) {
             Ok(mut finer) => {
                 spent += finer.seconds;
                 warnings.append(&mut finer.warnings);

@@ -64,7 +64,9 @@ pub fn torus(major: f64, minor: f64, segments: usize, sides: usize) -> TriSurfac
 
 /// Closed solid of revolution about the z axis. `profile` is a closed
 /// polyline (r, z) going counter-clockwise in the (r, z) half-plane; its
-/// first and last points must lie on the axis (r = 0).
+/// first and last points must lie on the axis (r = 0), or be the same point
+/// off the axis (an annulus, like [`tube`]: that ring is then written twice,
+/// and the repair of `tetrahedralize` or of a reader welds it).
 pub fn revolve(profile: &[(f64, f64)], segments: usize, name: &str) -> TriSurface {
     let n = segments.max(3);
     let mut v: Vec<[f64; 3]> = Vec::new();
@@ -97,6 +99,17 @@ pub fn revolve(profile: &[(f64, f64)], segments: usize, name: &str) -> TriSurfac
         }
     }
     single(v, f, name)
+}
+
+/// A tube (hollow cylinder) along z from 0 to `length`, radii `inner` <
+/// `outer` (m), its walls in `rows` rings of quads as a CAD export or a
+/// user's OBJ of a chime or pipe gives them (1: single strips the tube's length).
+pub fn tube(inner: f64, outer: f64, length: f64, rows: usize, segments: usize) -> TriSurface {
+    let z = |i: usize| length * i as f64 / rows as f64;
+    let mut profile = vec![(inner, 0.0)];
+    profile.extend((0..=rows).map(|i| (outer, z(i))));
+    profile.extend((0..=rows).rev().map(|i| (inner, z(i))));
+    revolve(&profile, segments, "tube")
 }
 
 /// A hemispherical bowl of outer radius `radius` and wall `thickness` (m)

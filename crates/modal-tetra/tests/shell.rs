@@ -120,11 +120,8 @@ fn a_chime_keeps_long_cells_along_its_axis_and_rings_like_the_structured_tube() 
     // everywhere (the curved-wall rule) would give ≈ 10× the tets; along
     // the straight axis the cells may reach 16 walls. Reference: the
     // generator's structured tube at 2 mm in every direction.
-    let (inner, outer, length, rows) = (0.0135, 0.015, 0.3, 15);
-    let mut profile: Vec<(f64, f64)> = vec![(inner, 0.0)];
-    profile.extend((0..=rows).map(|i| (outer, length * i as f64 / rows as f64)));
-    profile.extend((0..=rows).rev().map(|i| (inner, length * i as f64 / rows as f64)));
-    let surface = shapes::revolve(&profile, 48, "chime");
+    let (inner, outer, length) = (0.0135, 0.015, 0.3);
+    let surface = shapes::tube(inner, outer, length, 15, 48);
     let (mesh, report) = tetrahedralize(&surface, &TetOptions::default()).unwrap();
     assert_eq!(report.wall_layers, 1, "{report:?}");
     assert!(report.cell_m > 4.0 * (outer - inner), "axial edges kept long: {report:?}");
@@ -157,9 +154,8 @@ fn rotated(mut s: TriSurface, [a, b, c]: [f64; 3]) -> TriSurface {
 
 #[test]
 fn shells_of_several_shapes_and_orientations_are_layered_and_valid() {
-    // A pipe: an annulus revolved about the axis (no rim on the axis).
-    let pipe =
-        shapes::revolve(&[(0.030, 0.0), (0.032, 0.0), (0.032, 0.2), (0.030, 0.2), (0.030, 0.0)], 48, "pipe");
+    // A pipe in strips its whole length long (no rim on the axis).
+    let pipe = shapes::tube(0.030, 0.032, 0.2, 1, 48);
     let cases = [
         ("footed bowl", shapes::bowl(0.08, 0.005, 48)),
         ("plate", shapes::cuboid(0.15, 0.1, 0.002)),
