@@ -113,6 +113,28 @@ impl Bvh {
         point
     }
 
+    /// Whether some triangle lies within `radius` of `q`: [`Bvh::distance`]
+    /// `≤ radius`, visiting only the nodes that close (a sag test of a
+    /// point near the surface reads a few leaves, not a search from ∞).
+    pub fn is_within(&self, q: V3, radius: f64) -> bool {
+        let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0usize] };
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n];
+            if box_distance(q, node.lo, node.hi) > radius {
+                continue;
+            }
+            if node.count > 0 {
+                let tris = &self.tris[node.first..node.first + node.count];
+                if tris.iter().any(|t| norm(sub(q, closest_on_triangle(q, t[0], t[1], t[2]))) <= radius) {
+                    return true;
+                }
+            } else {
+                stack.extend(node.children);
+            }
+        }
+        false
+    }
+
     /// Input indices of the triangles whose bounding boxes meet the box [lo, hi].
     pub fn in_box(&self, lo: V3, hi: V3) -> Vec<usize> {
         let mut out = Vec::new();

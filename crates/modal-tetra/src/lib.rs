@@ -54,6 +54,7 @@
 //! [`TetraError::Parse`]; the default panic hook may still print it).
 
 mod bvh;
+mod coarsen;
 pub mod corpus;
 mod curve;
 mod diagnose;

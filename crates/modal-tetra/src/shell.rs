@@ -46,6 +46,7 @@ use std::collections::{BTreeMap, HashMap};
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
+use crate::coarsen::{coarsen, Targets};
 use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, V3};
 use crate::stuff::edge;
 
@@ -81,6 +82,13 @@ const MAX_PASSES: usize = 12;
 /// rule's: on a sphere every direction is curved and no edge exceeds `h_c`;
 /// along a pipe's axis edges reach the straight size.
 pub const MAX_BEND_PER_WALL: f64 = 0.1;
+
+/// A finely tessellated master skin is coarsened to the wall rule's size
+/// first (module `coarsen`), its new triangles and edges within this many
+/// wall thicknesses of the input: a crease, a bead or a tight curve keeps
+/// its input triangles, and the curved 10-node boundary puts the mid-edge
+/// nodes back on the input surface.
+pub const MAX_SAG_PER_WALL: f64 = 0.05;
 
 /// A layered mesh of a thin-walled solid.
 #[derive(Clone, Debug)]
@@ -168,7 +176,7 @@ pub(crate) fn layered(
     let opposite = Bvh::new(opposite.iter().map(|&t| triangles[t].map(|v| vertices[v])).collect());
     let layering =
         Layering { opposite: &opposite, reach: 3.0 * max_wall(&pairs), wall_m, layers, enclosed_volume };
-    let skin = Skin::from_triangles(vertices, triangles, &master);
+    let skin = Skin::from_triangles(vertices, triangles, &master).coarsened(&limits, wall_m);
     let max_triangles = sizing.max_tets / (3 * layers) + 1;
     // Longer edges along straight walls first; where their prisms fold or
     // miss volume (a bell's crown), every edge at the curved size.
@@ -559,6 +567,26 @@ impl Skin {
             out.triangles.push(tri);
         }
         out
+    }
+
+    /// The skin with its edges shorter than the wall rule asks collapsed
+    /// (module `coarsen`) into edges the refinement keeps (`limits`, with
+    /// the normals and curvatures of this fine skin), sagging at most
+    /// [`MAX_SAG_PER_WALL`] of the wall `wall_m` off the input.
+    fn coarsened(self, limits: &EdgeLimits, wall_m: f64) -> Skin {
+        let surface = Bvh::new(self.triangles.iter().map(|t| t.map(|v| self.vertices[v])).collect());
+        let field = NormalField::new(&self, wall_m);
+        let normals: Vec<V3> = self.vertices.par_iter().map(|&v| field.at(v)).collect();
+        let kappa = self.largest_normal_curvature(&normals);
+        let at = |v: usize| (self.vertices[v], normals[v]);
+        let fits = |a: usize, b: usize| {
+            let middle = || field.at(scale(add(self.vertices[a], self.vertices[b]), 0.5));
+            !limits.too_long(at(a), at(b), kappa[a].max(kappa[b]), middle)
+        };
+        let targets =
+            Targets { longest_m: limits.straight_m.max(limits.curved_m), sag_m: MAX_SAG_PER_WALL * wall_m };
+        let (vertices, triangles) = coarsen(&self.vertices, &self.triangles, &surface, targets, &fits);
+        Skin { vertices, triangles }
     }
 
     fn longest_edge(&self) -> f64 {
