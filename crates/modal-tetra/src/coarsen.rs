@@ -48,17 +48,11 @@ pub const MIN_QUALITY: f64 = 0.3;
 /// See [`MIN_QUALITY`].
 pub const INPUT_QUALITY_SHARE: f64 = 0.9;
 
-/// Edges shorter than this fraction of the longest the refinement keeps
-/// are collapsed (Botsch & Kobbelt's 4/5 of a target whose longest edge is
-/// 4/3 of it).
-pub const COLLAPSE_FRACTION: f64 = 0.6;
-
 /// What a coarsened skin must keep.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Targets {
-    /// The longest edge the refinement keeps anywhere [m]: shorter than
-    /// [`COLLAPSE_FRACTION`] of it, an edge is a candidate.
-    pub longest_m: f64,
+    /// Edges shorter than this are collapsed where the module doc allows [m].
+    pub short_m: f64,
     /// How far new triangles and edges may sag off the input skin [m].
     pub sag_m: f64,
 }
@@ -138,10 +132,10 @@ impl<'a> Collapse<'a> {
         }
     }
 
-    /// Collapses edges shorter than [`COLLAPSE_FRACTION`] of the largest
-    /// size, shortest first; returns how many.
+    /// Collapses edges shorter than `targets.short_m`, shortest first;
+    /// returns how many.
     fn collapse_short_edges(&mut self) -> usize {
-        let short = COLLAPSE_FRACTION * self.targets.longest_m;
+        let short = self.targets.short_m;
         let mut entries = Vec::new();
         for (t, _) in self.triangles.iter().zip(&self.alive).filter(|(_, &alive)| alive) {
             for k in 0..3 {
@@ -397,7 +391,7 @@ mod tests {
     fn coarsened(vertices: &[V3], triangles: &[[usize; 3]], longest: f64) -> (Vec<V3>, Vec<[usize; 3]>) {
         let surface = Bvh::new(triangles.iter().map(|t| t.map(|v| vertices[v])).collect());
         let fits = |a: usize, b: usize| norm(sub(vertices[a], vertices[b])) <= longest;
-        coarsen(vertices, triangles, &surface, Targets { longest_m: longest, sag_m: 1e-5 }, &fits)
+        coarsen(vertices, triangles, &surface, Targets { short_m: 0.6 * longest, sag_m: 1e-5 }, &fits)
     }
 
     fn area(vertices: &[V3], triangles: &[[usize; 3]]) -> V3 {

@@ -90,6 +90,17 @@ pub const MAX_BEND_PER_WALL: f64 = 0.1;
 /// nodes back on the input surface.
 pub const MAX_SAG_PER_WALL: f64 = 0.05;
 
+/// An input skin's edges shorter than this share of the longest the wall
+/// rule keeps anywhere (along a chime's axis, else the curved size) are
+/// collapsed where the rule keeps the result (Botsch & Kobbelt's 4/5 of a
+/// target whose longest edge is 4/3 of it).
+pub const INPUT_COLLAPSE_SHARE: f64 = 0.6;
+
+/// After the refinement, edges shorter than this share of the curved size
+/// are collapsed: bisection leaves edges of ½–1 of its limit, and what is
+/// shorter comes from the input (a CAD sliver's short side, cut across).
+pub const REFINED_COLLAPSE_SHARE: f64 = 0.35;
+
 /// A layered mesh of a thin-walled solid.
 #[derive(Clone, Debug)]
 pub(crate) struct Layered {
@@ -176,7 +187,11 @@ pub(crate) fn layered(
     let opposite = Bvh::new(opposite.iter().map(|&t| triangles[t].map(|v| vertices[v])).collect());
     let layering =
         Layering { opposite: &opposite, reach: 3.0 * max_wall(&pairs), wall_m, layers, enclosed_volume };
-    let skin = Skin::from_triangles(vertices, triangles, &master).coarsened(&limits, wall_m);
+    let skin = Skin::from_triangles(vertices, triangles, &master).coarsened(
+        &limits,
+        wall_m,
+        INPUT_COLLAPSE_SHARE * limits.straight_m,
+    );
     let max_triangles = sizing.max_tets / (3 * layers) + 1;
     // Longer edges along straight walls first; where their prisms fold or
     // miss volume (a bell's crown), every edge at the curved size.
@@ -215,6 +230,7 @@ impl Layering<'_> {
             estimated: 3 * layers * count,
             in_plane_m: limits.curved_m,
         })?;
+        let skin = skin.coarsened(limits, self.wall_m, REFINED_COLLAPSE_SHARE * limits.curved_m);
         // Normals first (they keep faceted curved walls one-to-one), closest
         // points where those fold (creases); neither: not meshed in layers.
         let columns = |rule| {
@@ -573,7 +589,7 @@ impl Skin {
     /// (module `coarsen`) into edges the refinement keeps (`limits`, with
     /// the normals and curvatures of this fine skin), sagging at most
     /// [`MAX_SAG_PER_WALL`] of the wall `wall_m` off the input.
-    fn coarsened(self, limits: &EdgeLimits, wall_m: f64) -> Skin {
+    fn coarsened(self, limits: &EdgeLimits, wall_m: f64, short_m: f64) -> Skin {
         let surface = Bvh::new(self.triangles.iter().map(|t| t.map(|v| self.vertices[v])).collect());
         let field = NormalField::new(&self, wall_m);
         let normals: Vec<V3> = self.vertices.par_iter().map(|&v| field.at(v)).collect();
@@ -583,8 +599,7 @@ impl Skin {
             let middle = || field.at(scale(add(self.vertices[a], self.vertices[b]), 0.5));
             !limits.too_long(at(a), at(b), kappa[a].max(kappa[b]), middle)
         };
-        let targets =
-            Targets { longest_m: limits.straight_m.max(limits.curved_m), sag_m: MAX_SAG_PER_WALL * wall_m };
+        let targets = Targets { short_m, sag_m: MAX_SAG_PER_WALL * wall_m };
         let (vertices, triangles) = coarsen(&self.vertices, &self.triangles, &surface, targets, &fits);
         Skin { vertices, triangles }
     }

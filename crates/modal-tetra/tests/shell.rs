@@ -177,6 +177,34 @@ fn a_finely_tessellated_chime_keeps_long_axial_cells() {
     assert!(worst < 0.005, "worst {:.3} %", 100.0 * worst);
 }
 
+#[test]
+fn a_cad_pipe_of_long_strips_is_meshed_like_one_exported_in_rows() {
+    // A CAD exporter writes a pipe as one row of strips, here 48 of 2.6 ×
+    // 100 mm. Bisected to the wall rule's size, each strip was cut across
+    // into pieces with sides of a fraction of a millimetre: 70 k tets with
+    // dihedral angles down to 0.1°, where the same pipe exported in rows of
+    // 2.5 mm takes 11.5 k. The short edges the bisection leaves are now
+    // collapsed.
+    let (inner, outer, length) = (0.018, 0.02, 0.1);
+    let (rows_mesh, rows) =
+        tetrahedralize(&shapes::tube(inner, outer, length, 40, 48), &TetOptions::default()).unwrap();
+    let (strips_mesh, strips) =
+        tetrahedralize(&shapes::tube(inner, outer, length, 1, 48), &TetOptions::default()).unwrap();
+    assert_eq!(strips.wall_layers, 1, "{strips:?}");
+    assert!(strips.tets < 3 * rows.tets / 2, "{} tets against {} in rows", strips.tets, rows.tets);
+    assert!(strips.min_dihedral_deg > 5.0, "{strips:?}");
+    let [ours, want] = [strips_mesh, rows_mesh].map(|m| frequencies(&modal_mesh::check(m).unwrap().0, 10));
+    let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+    println!(
+        "strips: {} tets (smallest dihedral {:.1}°), rows: {} tets; worst |f/f_rows − 1| over 10 modes: {:.3} %\nstrips {ours:.1?}\nrows   {want:.1?}",
+        strips.tets,
+        strips.min_dihedral_deg,
+        rows.tets,
+        100.0 * worst
+    );
+    assert!(worst < 0.003, "worst {:.3} %", 100.0 * worst);
+}
+
 /// Rotates a surface by angles about x, then y, then z [rad].
 fn rotated(mut s: TriSurface, [a, b, c]: [f64; 3]) -> TriSurface {
     for p in &mut s.vertices {
