@@ -107,7 +107,9 @@ fn a_slender_chime_gets_a_coarser_second_level_and_every_mode_an_estimate() {
         .and_then(|s| s.split(": ").nth(1))
         .map(|s| s.split(" and ").filter_map(|d| d.parse().ok()).collect())
         .unwrap_or_default();
-    assert!(dofs.len() == 2 && dofs[0] > 2.0 * dofs[1], "levels not distinct: {method}\n{stderr}");
+    // Sizes × 1.5 along a layered wall: ≈ 1.5² fewer DOF, less where the coarser skin keeps
+    // input edges (rims, the axial rows); the same mesh gives 1.
+    assert!(dofs.len() == 2 && dofs[0] > 1.6 * dofs[1], "levels not distinct: {method}\n{stderr}");
     let got = modes(&report);
     assert_eq!(got.len(), 6, "{stderr}");
     assert!(got.iter().all(|(_, e)| e.is_some_and(|e| e > 0.0 && e < 5.0)), "{got:?}\n{stderr}");
