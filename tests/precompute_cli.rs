@@ -244,3 +244,44 @@ fn a_mesh_beyond_the_memory_guard_is_refused_before_assembly() {
     assert!(text.contains("DOF") && text.contains("coarser mesh"), "{text}");
     assert!(!dir.path().join("a.bank").exists(), "no output on failure");
 }
+
+#[test]
+fn a_surface_whose_tets_cannot_fit_the_memory_guard_is_refused_before_meshing() {
+    // The example bar at a 1 mm cell: ≈ 720 k tets, whose K, M and factor need at least
+    // 8.6 GB. With a 1 GB guard it was meshed for 12 s (3.3 M DOF) and then refused.
+    let dir = temp_dir();
+    let bar = example("bar.obj");
+    let args = [
+        "precompute",
+        bar.to_str().unwrap(),
+        "-o",
+        "a.bank",
+        "--no-cache",
+        "--material",
+        "steel",
+        "--cell",
+        "0.001",
+    ];
+    let run = modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("1"))]);
+    let text = run.fails_with("would be meshed into about").stderr;
+    assert!(text.contains("memory limit of 1.0 GB") && text.contains("--cell"), "{text}");
+    assert!(!dir.path().join("a.bank").exists(), "no output on failure");
+}
+
+#[test]
+fn a_mesh_whose_factor_exceeds_the_memory_guard_is_refused_before_its_matrices_are_assembled() {
+    // A 5 cm cube at 4 mm, 59 k DOF: K and M ≈ 0.2 GB fit 0.3 GB, their factor (≈ 0.4 GB)
+    // does not. Refused from the symbolic analysis of the pattern, before the values exist
+    // (before: after assembly, by the eigensolver; at 4.5 M DOF that was 15 GB of K and M
+    // assembled and a 21.5 GB peak on a 24 GB machine). With 1 GB it is solved.
+    let dir = temp_dir();
+    modal(dir.path(), &["mesh", "box", "--size", "0.05,0.05,0.05", "--h", "0.004", "-o", "cube.msh"]).ok();
+    let args =
+        ["precompute", "cube.msh", "-o", "a.bank", "--no-cache", "--material", "steel", "--modes", "5"];
+    let run = modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("0.3"))]);
+    let text = run.fails_with("and their factor").stderr;
+    assert!(text.contains("59049 DOF") && text.contains("coarser mesh"), "{text}");
+    assert!(!dir.path().join("a.bank").exists(), "no output on failure");
+    modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("1"))]).ok();
+    assert!(dir.path().join("a.bank").exists());
+}

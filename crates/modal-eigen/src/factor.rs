@@ -136,6 +136,13 @@ pub struct Analysis {
 }
 
 impl Analysis {
+    /// Bytes of the factor's values (8 per stored entry), known from the
+    /// symbolic analysis before any matrix value exists: the bulk of a large
+    /// solve's memory, and a lower bound of it.
+    pub fn factor_value_bytes(&self) -> u64 {
+        self.symbolic.len_val() as u64 * 8
+    }
+
     /// Analysis of the symmetric pattern `pattern` (full or upper storage, sorted rows, every
     /// diagonal entry present). `use_metis`: METIS nested dissection of the node graph when
     /// the DOFs come in threes (else, or if METIS fails, faer's AMD).

@@ -77,6 +77,45 @@ impl LevelSize {
     }
 }
 
+/// The memory a surface's 10-node tets may take, known before meshing.
+///
+/// The solve holds K and M, at least
+/// [`modal_fem::min_quadratic_matrices_bytes`] (270 stored entries a tet, whatever
+/// the mesh), and the factor of `K − σM`, at least the lower triangle of that
+/// pattern (135 values of 8 bytes a tet): both lower bounds, so a mesh refused here
+/// could not have been solved within the limit, and it is refused in a second
+/// instead of after minutes of meshing and assembly (a thin bowl at a 1.2 mm cell:
+/// 1.6 M tets in 23 s, then refused for the matrices' 23 GB).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TetBudget {
+    /// The memory guard [bytes].
+    pub limit_bytes: u64,
+}
+
+impl TetBudget {
+    /// Bytes of the factor's values a 10-node tet brings at least (see the type doc).
+    const FACTOR_BYTES_PER_TET: u64 = 9 * modal_fem::MIN_NODE_PAIRS_PER_QUADRATIC_TET * 8;
+
+    /// The fewest bytes a solve of `tets` 10-node tets holds.
+    fn min_bytes(tets: u64) -> u64 {
+        modal_fem::min_quadratic_matrices_bytes(tets) + Self::FACTOR_BYTES_PER_TET * tets
+    }
+
+    /// The most tets whose solve can fit.
+    pub(crate) fn max_tets(&self) -> usize {
+        usize::try_from(self.limit_bytes / Self::min_bytes(1).max(1)).unwrap_or(usize::MAX)
+    }
+
+    fn refusal(&self, estimated: u64) -> PrecomputeError {
+        PrecomputeError::Invalid(format!(
+            "the surface would be meshed into about {estimated} tets, whose stiffness, mass and factor need at least \
+             {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
+            Self::min_bytes(estimated) as f64 / 1e9,
+            self.limit_bytes as f64 / 1e9
+        ))
+    }
+}
+
 /// True for file types that hold a surface to be tetrahedralized.
 pub fn is_surface_file(path: &Path) -> bool {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
@@ -89,16 +128,18 @@ pub fn load_mesh(
     scale: f64,
     surface: &SurfaceMeshing,
 ) -> Result<LoadedMesh, PrecomputeError> {
-    load_mesh_sized(source, scale, surface, None)
+    load_mesh_sized(source, scale, surface, None, None)
 }
 
 /// [`load_mesh`] with a surface mesh's tets sized by `level` when given (the
-/// discretization levels of `crate::levels`). Tet meshes are not touched.
+/// discretization levels of `crate::levels`), refused before meshing when the
+/// tetrahedralizer estimates more than `budget`'s tets. Tet meshes are not touched.
 pub(crate) fn load_mesh_sized(
     source: &MeshSource,
     scale: f64,
     surface: &SurfaceMeshing,
     level: Option<LevelSize>,
+    budget: Option<TetBudget>,
 ) -> Result<LoadedMesh, PrecomputeError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
@@ -115,7 +156,18 @@ pub(crate) fn load_mesh_sized(
                 Some(LevelSize::Factor(f)) => options.size_factor = f,
                 None => {}
             }
-            let (mesh, tet_report) = modal_tetra::tetrahedralize(&surf, &options)?;
+            if let Some(budget) = budget {
+                options.max_tets = options.max_tets.min(budget.max_tets());
+            }
+            let (mesh, tet_report) =
+                modal_tetra::tetrahedralize(&surf, &options).map_err(|e| match (e, budget) {
+                    (modal_tetra::TetraError::TooManyTets { estimated, .. }, Some(b))
+                        if estimated > b.max_tets() as u64 =>
+                    {
+                        b.refusal(estimated)
+                    }
+                    (e, _) => e.into(),
+                })?;
             warnings.extend(tet_report.warnings);
             cell_m = Some(tet_report.cell_m);
             layered = tet_report.wall_layers > 0;

@@ -10,7 +10,7 @@ use modal_fem::Material;
 use modal_mesh::TetMesh;
 
 use crate::levels::AccuracyTarget;
-use crate::load::{load_mesh_sized, LevelSize, SurfaceMeshing};
+use crate::load::{load_mesh_sized, LevelSize, SurfaceMeshing, TetBudget};
 use crate::{cache_key, MeshSource, PrecomputeError};
 
 /// What to compute. `Default` gives the CLI's defaults for everything but
@@ -181,25 +181,38 @@ pub(crate) fn assemble_and_analyze(
 ) -> Result<(Assembled, Option<modal_eigen::Analysis>), PrecomputeError> {
     request.validate()?;
     progress(Stage::Load);
-    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level)?;
+    let limit = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
+    let budget = limit.filter(|_| request.order == 2).map(|limit_bytes| TetBudget { limit_bytes });
+    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level, budget)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
     progress(Stage::Assemble { dofs: 3 * mesh.nodes.len() });
     let start = Instant::now();
     // Refuse before assembly what the solver's memory guard would refuse after it.
-    let limit = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
     let pattern = modal_fem::SparsityPattern::new_within(&mesh, limit)?;
-    let (assembly, analysis) = if analyze && request.fix_box.is_none() {
-        // A failed analysis is not an error here: the solve redoes it and reports.
-        let (assembly, analysis) = rayon::join(
-            || pattern.assemble(&mesh, &request.material),
-            || modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok(),
-        );
-        (assembly?, analysis)
-    } else {
-        (pattern.assemble(&mesh, &request.material)?, None)
-    };
+    let matrices_bytes = modal_fem::matrices_bytes(pattern.nnz() as u64, pattern.dof_count() as u64);
+    let (assembly, analysis) =
+        if analyze && request.fix_box.is_none() && limit.is_some_and(|l| matrices_bytes > l / 8) {
+            // A large mesh: the factor's size first, from the pattern alone, so a mesh whose
+            // factor cannot fit is refused before its matrices take most of the memory
+            // (4.5 M DOF: 15 GB of K and M assembled, then a 110 GB factor refused).
+            let analysis =
+                modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok();
+            if let (Some(a), Some(limit)) = (&analysis, limit) {
+                refuse_beyond_memory(pattern.dof_count(), matrices_bytes, a.factor_value_bytes(), limit)?;
+            }
+            (pattern.assemble(&mesh, &request.material)?, analysis)
+        } else if analyze && request.fix_box.is_none() {
+            // A failed analysis is not an error here: the solve redoes it and reports.
+            let (assembly, analysis) = rayon::join(
+                || pattern.assemble(&mesh, &request.material),
+                || modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok(),
+            );
+            (assembly?, analysis)
+        } else {
+            (pattern.assemble(&mesh, &request.material)?, None)
+        };
     let assembled = Assembled {
         mesh,
         parts: loaded.parts,
@@ -212,6 +225,26 @@ pub(crate) fn assemble_and_analyze(
         layered: loaded.layered,
     };
     Ok((assembled, analysis))
+}
+
+/// Refuses a solve whose K and M (`matrices_bytes`) and factor values
+/// (`factor_bytes`), both held during the solve, exceed `limit` [bytes].
+fn refuse_beyond_memory(
+    dofs: usize,
+    matrices_bytes: u64,
+    factor_bytes: u64,
+    limit: u64,
+) -> Result<(), PrecomputeError> {
+    if matrices_bytes + factor_bytes <= limit {
+        return Ok(());
+    }
+    Err(PrecomputeError::Invalid(format!(
+        "the mesh has {dofs} DOF: its stiffness and mass matrices need ≈ {:.1} GB and their factor ≈ {:.1} GB, above \
+         the memory limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
+        matrices_bytes as f64 / 1e9,
+        factor_bytes as f64 / 1e9,
+        limit as f64 / 1e9
+    )))
 }
 
 /// Part ids for a mesh whose first nodes are those of the checked mesh and

@@ -70,6 +70,7 @@ mod shell;
 mod sizing;
 mod stuff;
 mod surface;
+mod wall_rule;
 
 pub use curve::{MAX_BULGE, MIN_JACOBIAN_RATIO};
 pub use diagnose::{diagnose, SurfaceReport};

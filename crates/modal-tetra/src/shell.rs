@@ -19,11 +19,16 @@
 //!    surface ([`master_sides`]). A skin that faces itself (a handle's tube)
 //!    means the body is no shell, and stuffing is used. Paired triangles
 //!    must hold [`MIN_PAIRED_AREA`] of the area (the rest are rims).
-//! 3. **Master skin** refined by longest-edge bisection (Rivara) until no
-//!    edge exceeds the in-plane size (conforming). On a slender shell
-//!    ([`slender_length`]), where the wall is straight along an edge and
-//!    curved across it (a chime's axis), the edge may be longer ([`EdgeLimits`]); where that folds a
-//!    prism or misses volume (a bell's crown), every edge is refined.
+//! 3. **Master skin** brought to the wall rule's edges (module
+//!    `wall_rule`): a finely tessellated skin is coarsened first (module
+//!    `coarsen`: edges shorter than [`INPUT_COLLAPSE_SHARE`] of the rule's
+//!    longest are collapsed), then refined by longest-edge bisection
+//!    (Rivara) until no edge exceeds the in-plane size (conforming), then
+//!    the short edges bisection leaves of the input's slivers are collapsed
+//!    ([`REFINED_COLLAPSE_SHARE`]). On a slender shell ([`slender_length`]),
+//!    where the wall is straight along an edge and curved across it (a
+//!    chime's axis), the edge may be longer ([`EdgeLimits`]); where that
+//!    folds a prism or misses volume (a bell's crown), every edge is refined.
 //! 4. **Columns** from each master vertex to the opposite side, divided into
 //!    `layers` equal steps: rays along the normal averaged over a wall
 //!    thickness, or, where those fold, the closest points ([`Columns`]).
@@ -49,6 +54,7 @@ use crate::bvh::Bvh;
 use crate::coarsen::{coarsen, Targets};
 use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, V3};
 use crate::stuff::edge;
+use crate::wall_rule::{bend, slender_length, EdgeLimits};
 
 /// Walls up to this fraction of the bounding-box diagonal can pair.
 pub const MAX_WALL_FRACTION: f64 = 0.1;
@@ -67,21 +73,6 @@ pub const VOLUME_TOLERANCE: f64 = 0.05;
 
 /// Refinement passes of the master skin (each at least halves the longest edge).
 const MAX_PASSES: usize = 12;
-
-/// An edge longer than the curved in-plane size `h_c` is kept where the wall
-/// is straight along it and curved across it: its bend
-/// `|(n_b − n_a)·(x_b − x_a)| = L²·κ_n` (`κ_n` the normal curvature along
-/// the edge, from its ends' normals) at most what an edge of `h_c` bends in
-/// the most curved direction at its ends (`h_c²·κ_max`, `κ_max` the largest
-/// `κ_n` of the edges there), and that bend more than this many wall
-/// thicknesses (a wall flatter than that, a plate, keeps `h_c` in every
-/// direction: a 15 × 10 cm steel plate 2 mm thick at 3.1 mm edges is within
-/// 0.28 % of two layers at 1 mm on 16 modes, at 6.25 mm 0.94 %). `L²κ/t` is
-/// what makes flat-faceted elements on a curved wall stiffen (membrane
-/// locking), so a longer edge never bends more than the validated `h_c`
-/// rule's: on a sphere every direction is curved and no edge exceeds `h_c`;
-/// along a pipe's axis edges reach the straight size.
-pub const MAX_BEND_PER_WALL: f64 = 0.1;
 
 /// A finely tessellated master skin is coarsened to the wall rule's size
 /// first (module `coarsen`), its new triangles and edges within this many
@@ -249,113 +240,6 @@ impl Layering<'_> {
         }
         Ok((skin, mesh))
     }
-}
-
-/// How long a master-skin edge may be (step 3 of the module doc).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct EdgeLimits {
-    /// Any edge up to this length is kept [m].
-    curved_m: f64,
-    /// A longer edge is kept up to this length where the wall is straight
-    /// along it and curved across it (a pipe's axis) [m].
-    straight_m: f64,
-    /// "Curved across": an edge of `curved_m` bends more than this
-    /// ([`MAX_BEND_PER_WALL`]) [m].
-    bend_m: f64,
-}
-
-impl EdgeLimits {
-    /// The limits of a wall `wall_m` thick; `slender` the length of a
-    /// slender body ([`slender_length`]), `None`: no long cells.
-    fn new(sizing: &LayerSizing, wall_m: f64, slender: Option<f64>) -> EdgeLimits {
-        let curved_m = sizing.in_plane_m.unwrap_or((sizing.wall_cells * wall_m).min(sizing.max_in_plane_m));
-        let straight_m = match (sizing.in_plane_m, slender) {
-            (None, Some(length)) => (sizing.straight_wall_cells * wall_m)
-                .min(length / SLENDER_CELLS_PER_LENGTH * sizing.size_factor)
-                .min(sizing.max_in_plane_m)
-                .max(curved_m),
-            _ => curved_m,
-        };
-        EdgeLimits { curved_m, straight_m, bend_m: MAX_BEND_PER_WALL * wall_m }
-    }
-
-    /// Every edge at the curved size.
-    fn isotropic(&self) -> EdgeLimits {
-        EdgeLimits { straight_m: self.curved_m, ..*self }
-    }
-
-    fn is_isotropic(&self) -> bool {
-        self.straight_m <= self.curved_m
-    }
-
-    /// Whether the edge from `a` to `b` (normals `na`, `nb`; `kappa` the
-    /// larger `κ_max` of its ends [1/m]) must be split.
-    fn too_long(&self, (a, na): (V3, V3), (b, nb): (V3, V3), kappa: f64, middle: impl Fn() -> V3) -> bool {
-        let d = sub(b, a);
-        let length = norm(d);
-        let across = self.curved_m * self.curved_m * kappa;
-        if length <= self.curved_m {
-            return false;
-        }
-        if length > self.straight_m || across <= self.bend_m || bend(d, sub(nb, na)) > across {
-            return true;
-        }
-        // Straight between its ends, but maybe not in between (across a crease).
-        let (half, nm) = (scale(d, 0.5), middle());
-        bend(half, sub(nm, na)).max(bend(half, sub(nb, nm))) > 0.25 * across
-    }
-}
-
-/// A body is slender when its length along its principal axis is at least
-/// this many times its largest diameter across it.
-pub const SLENDER_RATIO: f64 = 5.0;
-
-/// Long cells along a slender wall are at most its length over this (the
-/// generated tubes' axial rule).
-pub const SLENDER_CELLS_PER_LENGTH: f64 = 20.0;
-
-/// The length of the body through `points` along its principal axis (the
-/// covariance's dominant eigenvector, by power iteration) when that is at
-/// least [`SLENDER_RATIO`] times its diameter across the axis; `None`
-/// otherwise. Long cells are for slender tubes only: their low modes bend
-/// the whole cross-section (beams) or vary slowly along the axis (rings),
-/// while on a compact shell a mode bends the wall through its thickness in
-/// every direction, and one layer of 10-node tets stiffens under long cells
-/// (a 15 cm bell's crown flap mode 55 % high at 5.4 wall thicknesses along
-/// its generatrix; a plate at 4 walls 0.94 % against 0.28 % at 2).
-fn slender_length(points: &[V3]) -> Option<f64> {
-    let n = points.len() as f64;
-    if points.is_empty() {
-        return None;
-    }
-    let centre = scale(points.iter().fold([0.0; 3], |acc, &p| add(acc, p)), 1.0 / n);
-    let mut covariance = [[0.0; 3]; 3];
-    for p in points {
-        let d = sub(*p, centre);
-        for (i, row) in covariance.iter_mut().enumerate() {
-            for (j, c) in row.iter_mut().enumerate() {
-                *c += d[i] * d[j];
-            }
-        }
-    }
-    let mut axis = [1.0, 0.7, 0.4];
-    for _ in 0..100 {
-        axis = unit(covariance.map(|row| dot(row, axis)));
-    }
-    let (mut lo, mut hi, mut radius) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for p in points {
-        let d = sub(*p, centre);
-        let along = dot(d, axis);
-        (lo, hi) = (lo.min(along), hi.max(along));
-        radius = radius.max(norm(sub(d, scale(axis, along))));
-    }
-    let length = hi - lo;
-    (length >= SLENDER_RATIO * 2.0 * radius).then_some(length)
-}
-
-/// `|Δn·Δx| = L²·κ_n` of an edge `d` whose ends' normals differ by `dn` [m].
-fn bend(d: V3, dn: V3) -> f64 {
-    dot(dn, d).abs()
 }
 
 /// A triangle's pairing: its area, its wall thickness and the triangle its ray reached.
