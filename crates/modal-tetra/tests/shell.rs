@@ -22,6 +22,11 @@ fn frequencies(mesh: &TetMesh, count: usize) -> Vec<f64> {
     solve(&a.k, &a.m, Some(rigid.as_ref()), &options, &mut |_| {}).unwrap().frequencies_hz()
 }
 
+/// The largest |f/g − 1| over paired frequencies.
+fn worst_rel(ours: &[f64], want: &[f64]) -> f64 {
+    ours.iter().zip(want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max)
+}
+
 /// The corner-triangle boundary of a tet mesh as a surface file would give it.
 fn surface_of(mesh: &TetMesh) -> TriSurface {
     let s = boundary_surface(mesh);
@@ -50,7 +55,7 @@ fn a_bowl_surface_is_meshed_in_one_layer_and_rings_like_the_structured_bowl() {
         let (checked, r) = modal_mesh::check(mesh.clone()).unwrap();
         assert_eq!(r.reoriented, 0, "all tets positively oriented");
         let ours = frequencies(&checked, 12);
-        let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+        let worst = worst_rel(&ours, &want);
         println!(
             "{} input triangles at {:.1} mm: {} layered tets (in-plane {:.2} mm, wall {:.2} mm, smallest dihedral {:.1}°), worst |f/f_ref − 1| over 12 modes: {:.3} %\nours {ours:.1?}\nref  {want:.1?}",
             surface.triangles.len(),
@@ -140,7 +145,7 @@ fn a_chime_keeps_long_cells_along_its_axis_and_rings_like_the_structured_tube() 
     assert_eq!(r.reoriented, 0, "all tets positively oriented");
     let shape = Shape::Tube { inner_radius: inner, outer_radius: outer, length };
     let (ours, want) = (frequencies(&checked, 10), frequencies(&generate(&shape, 0.002, 2).unwrap(), 10));
-    let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+    let worst = worst_rel(&ours, &want);
     println!(
         "{} layered tets (longest edge {:.1} mm), worst |f/f_ref − 1| over 10 modes: {:.3} %\nours {ours:.1?}\nref  {want:.1?}",
         report.tets,
@@ -165,7 +170,7 @@ fn a_finely_tessellated_chime_keeps_long_axial_cells() {
     let (checked, _) = modal_mesh::check(mesh).unwrap();
     let shape = Shape::Tube { inner_radius: inner, outer_radius: outer, length };
     let (ours, want) = (frequencies(&checked, 10), frequencies(&generate(&shape, 0.002, 2).unwrap(), 10));
-    let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+    let worst = worst_rel(&ours, &want);
     println!(
         "{} input triangles → {} tets (the coarse export: {}), longest edge {:.1} mm, worst |f/f_ref − 1| over 10 modes: {:.3} %\nours {ours:.1?}\nref  {want:.1?}",
         fine.triangles.len(),
@@ -194,7 +199,7 @@ fn a_cad_pipe_of_long_strips_is_meshed_like_one_exported_in_rows() {
     assert!(strips.tets < 3 * rows.tets / 2, "{} tets against {} in rows", strips.tets, rows.tets);
     assert!(strips.min_dihedral_deg > 5.0, "{strips:?}");
     let [ours, want] = [strips_mesh, rows_mesh].map(|m| frequencies(&modal_mesh::check(m).unwrap().0, 10));
-    let worst = ours.iter().zip(&want).map(|(f, g)| common::rel(*f, *g).abs()).fold(0.0, f64::max);
+    let worst = worst_rel(&ours, &want);
     println!(
         "strips: {} tets (smallest dihedral {:.1}°), rows: {} tets; worst |f/f_rows − 1| over 10 modes: {:.3} %\nstrips {ours:.1?}\nrows   {want:.1?}",
         strips.tets,
