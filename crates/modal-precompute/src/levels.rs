@@ -243,7 +243,12 @@ pub(crate) fn solve_to_accuracy(
                 warnings.append(&mut finer.warnings);
                 coarse = std::mem::replace(&mut fine, finer);
             }
-            Err(err @ (PrecomputeError::Eigen(_) | PrecomputeError::Tetra(_))) => {
+            Err(
+                err @ (PrecomputeError::Eigen(_)
+                | PrecomputeError::Tetra(_)
+                | PrecomputeError::Memory(_)
+                | PrecomputeError::Fem(modal_fem::FemError::TooLarge { .. })),
+            ) => {
                 warnings.push(format!(
                     "{reached} ({} DOF): the next finer level (cell {:.2e} m) was refused: {err}",
                     fine.dofs,

@@ -72,4 +72,7 @@ pub enum PrecomputeError {
     /// Parameters that make no sense.
     #[error("{0}")]
     Invalid(String),
+    /// The mesh's solve cannot fit the memory guard (found before the work).
+    #[error("{0}")]
+    Memory(String),
 }

@@ -107,7 +107,7 @@ impl TetBudget {
     }
 
     fn refusal(&self, estimated: u64) -> PrecomputeError {
-        PrecomputeError::Invalid(format!(
+        PrecomputeError::Memory(format!(
             "the surface would be meshed into about {estimated} tets, whose stiffness, mass and factor need at least \
              {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
             Self::min_bytes(estimated) as f64 / 1e9,

@@ -238,7 +238,7 @@ fn refuse_beyond_memory(
     if matrices_bytes + factor_bytes <= limit {
         return Ok(());
     }
-    Err(PrecomputeError::Invalid(format!(
+    Err(PrecomputeError::Memory(format!(
         "the mesh has {dofs} DOF: its stiffness and mass matrices need ≈ {:.1} GB and their factor ≈ {:.1} GB, above \
          the memory limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
         matrices_bytes as f64 / 1e9,
