@@ -192,23 +192,22 @@ pub(crate) fn assemble_and_analyze(
     // Refuse before assembly what the solver's memory guard would refuse after it.
     let pattern = modal_fem::SparsityPattern::new_within(&mesh, limit)?;
     let matrices_bytes = modal_fem::matrices_bytes(pattern.nnz() as u64, pattern.dof_count() as u64);
+    // A failed analysis is not an error here: the solve redoes it and reports.
+    let analyze_pattern =
+        || modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok();
     let (assembly, analysis) =
         if analyze && request.fix_box.is_none() && limit.is_some_and(|l| matrices_bytes > l / 8) {
             // A large mesh: the factor's size first, from the pattern alone, so a mesh whose
             // factor cannot fit is refused before its matrices take most of the memory
             // (4.5 M DOF: 15 GB of K and M assembled, then a 110 GB factor refused).
-            let analysis =
-                modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok();
+            let analysis = analyze_pattern();
             if let (Some(a), Some(limit)) = (&analysis, limit) {
                 refuse_beyond_memory(pattern.dof_count(), matrices_bytes, a.factor_value_bytes(), limit)?;
             }
             (pattern.assemble(&mesh, &request.material)?, analysis)
         } else if analyze && request.fix_box.is_none() {
-            // A failed analysis is not an error here: the solve redoes it and reports.
-            let (assembly, analysis) = rayon::join(
-                || pattern.assemble(&mesh, &request.material),
-                || modal_eigen::analyze(pattern.symbolic().as_ref(), modal_eigen::Ordering::Auto).ok(),
-            );
+            let (assembly, analysis) =
+                rayon::join(|| pattern.assemble(&mesh, &request.material), analyze_pattern);
             (assembly?, analysis)
         } else {
             (pattern.assemble(&mesh, &request.material)?, None)

@@ -136,15 +136,8 @@ impl<'a> Collapse<'a> {
     /// returns how many.
     fn collapse_short_edges(&mut self) -> usize {
         let short = self.targets.short_m;
-        let mut entries = Vec::new();
-        for (t, _) in self.triangles.iter().zip(&self.alive).filter(|(_, &alive)| alive) {
-            for k in 0..3 {
-                entries.extend(self.entry_if_short(t[k], t[(k + 1) % 3], short));
-            }
-        }
-        // Each inner edge came twice; one entry each keeps the order the same.
-        entries.sort_unstable();
-        entries.dedup();
+        let entries: Vec<Entry> =
+            self.live_edges().into_iter().filter_map(|(a, b)| self.entry_if_short(a, b, short)).collect();
         let mut queue = BinaryHeap::from(entries);
         let mut count = 0;
         while let Some(Reverse((_, a, b))) = queue.pop() {
@@ -168,13 +161,18 @@ impl<'a> Collapse<'a> {
 
     /// One sweep of edge flips over the inner edges, in vertex order; returns how many.
     fn flip_to_better_shapes(&mut self) -> usize {
+        self.live_edges().into_iter().filter(|&(a, b)| self.try_flip(a, b)).count()
+    }
+
+    /// Every edge of the live triangles once, as `(smaller, larger)` vertex, sorted.
+    fn live_edges(&self) -> Vec<(usize, usize)> {
         let mut edges: Vec<(usize, usize)> = Vec::new();
         for (t, _) in self.triangles.iter().zip(&self.alive).filter(|(_, &alive)| alive) {
             edges.extend((0..3).map(|k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))));
         }
         edges.sort_unstable();
         edges.dedup();
-        edges.into_iter().filter(|&(a, b)| self.try_flip(a, b)).count()
+        edges
     }
 
     /// Replaces the diagonal `a`–`b` of its two triangles by the other one

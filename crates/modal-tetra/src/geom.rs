@@ -45,6 +45,17 @@ pub fn orient6(a: V3, b: V3, c: V3, d: V3) -> f64 {
     dot(cross(sub(b, a), sub(c, a)), sub(d, a))
 }
 
+/// `v / |v|`, or `v` itself when it is zero.
+#[inline]
+pub fn unit(v: V3) -> V3 {
+    let n = norm(v);
+    if n > 0.0 {
+        scale(v, 1.0 / n)
+    } else {
+        v
+    }
+}
+
 /// Area vector ½ (b−a)×(c−a) of a triangle (outward for counter-clockwise).
 #[inline]
 pub fn area_vector(a: V3, b: V3, c: V3) -> V3 {

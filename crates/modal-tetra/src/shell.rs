@@ -52,7 +52,7 @@ use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::coarsen::{coarsen, Targets};
-use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, V3};
+use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, unit, V3};
 use crate::stuff::edge;
 use crate::wall_rule::{bend, slender_length, EdgeLimits};
 
@@ -248,15 +248,6 @@ struct Pair {
     area: f64,
     thickness: f64,
     partner: Option<usize>,
-}
-
-fn unit(v: V3) -> V3 {
-    let n = norm(v);
-    if n > 0.0 {
-        scale(v, 1.0 / n)
-    } else {
-        v
-    }
 }
 
 /// Step 1 of the module doc, per triangle.
@@ -474,7 +465,6 @@ impl Skin {
     /// the normals and curvatures of this fine skin), sagging at most
     /// [`MAX_SAG_PER_WALL`] of the wall `wall_m` off the input.
     fn coarsened(self, limits: &EdgeLimits, wall_m: f64, short_m: f64) -> Skin {
-        let surface = Bvh::new(self.triangles.iter().map(|t| t.map(|v| self.vertices[v])).collect());
         let field = NormalField::new(&self, wall_m);
         let normals: Vec<V3> = self.vertices.par_iter().map(|&v| field.at(v)).collect();
         let kappa = self.largest_normal_curvature(&normals);
@@ -484,7 +474,7 @@ impl Skin {
             !limits.too_long(at(a), at(b), kappa[a].max(kappa[b]), middle)
         };
         let targets = Targets { short_m, sag_m: MAX_SAG_PER_WALL * wall_m };
-        let (vertices, triangles) = coarsen(&self.vertices, &self.triangles, &surface, targets, &fits);
+        let (vertices, triangles) = coarsen(&self.vertices, &self.triangles, &field.near, targets, &fits);
         Skin { vertices, triangles }
     }
 

@@ -9,7 +9,7 @@
 //!
 //! (`κ_n` the normal curvature along the edge, `h_c` the curved size).
 
-use crate::geom::{add, dot, norm, scale, sub, V3};
+use crate::geom::{add, dot, norm, scale, sub, unit, V3};
 use crate::shell::LayerSizing;
 
 /// An edge longer than the curved in-plane size `h_c` is kept where the wall
@@ -138,13 +138,4 @@ pub(crate) fn slender_length(points: &[V3]) -> Option<f64> {
 /// `|Δn·Δx| = L²·κ_n` of an edge `d` whose ends' normals differ by `dn` [m].
 pub(crate) fn bend(d: V3, dn: V3) -> f64 {
     dot(dn, d).abs()
-}
-
-fn unit(v: V3) -> V3 {
-    let n = norm(v);
-    if n > 0.0 {
-        scale(v, 1.0 / n)
-    } else {
-        v
-    }
 }
