@@ -14,6 +14,7 @@ use crate::graded::MAX_LEVELS;
 use crate::lattice::Lattice;
 use crate::shell::{layered, LayerSizing, Layered, NotLayered};
 use crate::sizing::{surface_gap, Sizing};
+use crate::smooth::{averaged_normals, taubin};
 use crate::stuff::{background, stuff, Stuffed};
 use crate::{TetraError, TriSurface};
 
@@ -322,17 +323,22 @@ pub fn tetrahedralize(
     let bvh = Bvh::new(tris);
     let mut warnings = Vec::new();
     let layered = try_layered(&repaired, &bvh, options, (diagonal, volume, area), &mut warnings)?;
-    let (mut stuffed, h, thin_samples, min_thickness_m, wall_layers) = match layered {
-        Some(l) => {
+    let (mut stuffed, h, thin_samples, min_thickness_m, wall_layers, smoothed) = match layered {
+        Some(LayeredWall { mesh: l, smoothed }) => {
             let stuffed = Stuffed { nodes: l.nodes, tets: l.tets, dropped: 0, min_cell: l.shortest_edge_m };
-            (stuffed, l.longest_edge_m, 0, Some(l.wall_m), l.layers)
+            (stuffed, l.longest_edge_m, 0, Some(l.wall_m), l.layers, smoothed)
         }
         None => {
             let (stuffed, h, thin_samples, min_thickness_m) =
                 stuff_surface(&repaired, &bvh, options, (lo, hi), (h0, diagonal, volume), &mut warnings)?;
-            (stuffed, h, thin_samples, min_thickness_m, 0)
+            (stuffed, h, thin_samples, min_thickness_m, 0, None)
         }
     };
+    // A smoothed surface is the one the curved boundary follows; the
+    // deviations reported stay against the input.
+    let smoothed_bvh =
+        smoothed.map(|s| Bvh::new(repaired.triangles.iter().map(|t| t.map(|v| s[v])).collect()));
+    let follow = smoothed_bvh.as_ref().unwrap_or(&bvh);
     let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     // A layered wall's nodes are on its skins already; snapping within a
@@ -360,7 +366,7 @@ pub fn tetrahedralize(
         ));
     }
     let (mesh, curved_edges, straightened_elements) = if options.curved {
-        let curved = curve(stuffed.nodes, stuffed.tets, &bvh);
+        let curved = curve(stuffed.nodes, stuffed.tets, follow);
         volume_m3 = modal_mesh::mesh_volume(&curved.mesh);
         max_surface_deviation_m =
             max_surface_deviation_m.max(deviation(&curved.mesh.nodes, &curved.boundary_mids, &bvh));
@@ -418,7 +424,7 @@ fn try_layered(
     options: &TetOptions,
     (diagonal, volume, area): (f64, f64, f64),
     warnings: &mut Vec<String>,
-) -> Result<Option<Layered>, TetraError> {
+) -> Result<Option<LayeredWall>, TetraError> {
     if options.graded || options.target_tets.is_some() || !(volume > 0.0 && area > 0.0) {
         return Ok(None);
     }
@@ -437,28 +443,130 @@ fn try_layered(
     };
     let volume_m3 = repaired.report.enclosed_volume_m3;
     let components = repaired.report.components;
-    match layered(&repaired.vertices, &repaired.triangles, bvh, diagonal, (volume_m3, components), sizing) {
-        Ok(l) => Ok(Some(l)),
-        Err(NotLayered::TooMany { estimated, in_plane_m }) => {
-            // Tets go as cell⁻² here; the error's hint assumes cell⁻³.
-            let ratio = estimated as f64 / options.max_tets as f64;
-            Err(TetraError::TooManyTets {
-                cell_m: in_plane_m,
-                estimated: (options.max_tets as f64 * ratio.powf(1.5)) as u64,
-                limit: options.max_tets,
-            })
+    let shape = (volume_m3, components);
+    let too_many = |estimated: usize, in_plane_m: f64| {
+        // Tets go as cell⁻² here; the error's hint assumes cell⁻³.
+        let ratio = estimated as f64 / options.max_tets as f64;
+        TetraError::TooManyTets {
+            cell_m: in_plane_m,
+            estimated: (options.max_tets as f64 * ratio.powf(1.5)) as u64,
+            limit: options.max_tets,
         }
-        Err(reason) => {
-            warnings.push(not_layered_warning(&reason, wall));
-            Ok(None)
+    };
+    let reason = match layered(&repaired.vertices, &repaired.triangles, bvh, diagonal, shape, sizing, false) {
+        Ok(l) => return Ok(Some(LayeredWall { mesh: l, smoothed: None })),
+        Err(NotLayered::TooMany { estimated, in_plane_m }) => return Err(too_many(estimated, in_plane_m)),
+        Err(reason) => reason,
+    };
+    if let Some(smoothed) = Smoothed::if_only_noise(repaired, bvh, wall) {
+        match layered_when_smoothed(repaired, &smoothed, diagonal, shape, sizing) {
+            Ok(mesh) => {
+                warnings.push(smoothed.warning(&reason, mesh.wall_m));
+                return Ok(Some(LayeredWall { mesh, smoothed: Some(smoothed.vertices) }));
+            }
+            Err(NotLayered::TooMany { estimated, in_plane_m }) => {
+                return Err(too_many(estimated, in_plane_m))
+            }
+            Err(_) => {}
         }
     }
+    warnings.push(not_layered_warning(&reason, wall));
+    Ok(None)
+}
+
+/// Passes of Taubin smoothing (module `smooth`) of a surface not layered as
+/// given: at most 7 % of a scan's vertex-to-vertex noise is left after 10.
+pub const NOISE_SMOOTHING_PASSES: usize = 10;
+
+/// Edges whose faces' normals, averaged over [`CREASE_NORMAL_RADIUS_PER_WALL`]
+/// (`smooth::averaged_normals`), turn by more than this are creases the
+/// smoothing keeps (a rim's 90°; a scan's noise tilts single 1–2 mm facets
+/// by tens of degrees, but hardly their average).
+pub const SMOOTHING_CREASE_DEG: f64 = 60.0;
+
+/// Half-side of the cube the crease test's normals are averaged over, in
+/// walls (2V/A): a few of a scan's triangles, well inside the wall.
+pub const CREASE_NORMAL_RADIUS_PER_WALL: f64 = 1.0 / 3.0;
+
+/// The smoothed copy is used only when 99 % of its vertices stay within
+/// this many wall thicknesses (2V/A) of the input surface, so the wall it
+/// meshes is the input's. Measured (99th percentile, walls): noisy bowls
+/// with 0.1 mm rms on 4 and 6 mm walls 0.045 and 0.043; clean inputs, whose
+/// faceted corners the filter pulls in, 0.000 (plate) to 0.057 (a bowl of
+/// 6 k triangles), 0.094 and 0.152 (the corpus and 15 cm bells' lips).
+pub const MAX_SMOOTHING_SHIFT_PER_WALL: f64 = 0.1;
+
+/// A layered mesh, and the smoothed surface it was made from, if any
+/// (its curved boundary follows that surface, not the noise).
+pub(crate) struct LayeredWall {
+    mesh: Layered,
+    smoothed: Option<Vec<V3>>,
+}
+
+/// The input surface's vertices after Taubin smoothing, and how far they
+/// lie from the input surface [m]: the median, the 99th percentile, the largest.
+struct Smoothed {
+    vertices: Vec<V3>,
+    shift_m: [f64; 3],
+}
+
+impl Smoothed {
+    /// The smoothed surface, when it differs from `repaired` (with `bvh`
+    /// over it) by noise alone ([`MAX_SMOOTHING_SHIFT_PER_WALL`] of `wall`).
+    fn if_only_noise(repaired: &Repaired, bvh: &Bvh, wall: f64) -> Option<Smoothed> {
+        let (v, t) = (&repaired.vertices, &repaired.triangles);
+        let normals = averaged_normals(v, t, bvh, CREASE_NORMAL_RADIUS_PER_WALL * wall);
+        let vertices = taubin(v, t, &normals, SMOOTHING_CREASE_DEG, NOISE_SMOOTHING_PASSES);
+        let mut shift: Vec<f64> = vertices.par_iter().map(|&p| bvh.distance(p)).collect();
+        if shift.is_empty() {
+            return None;
+        }
+        shift.sort_by(f64::total_cmp);
+        let at = |q: f64| shift[((shift.len() - 1) as f64 * q).round() as usize];
+        let shift_m = [at(0.5), at(0.99), at(1.0)];
+        (shift_m[1] <= MAX_SMOOTHING_SHIFT_PER_WALL * wall).then_some(Smoothed { vertices, shift_m })
+    }
+
+    /// What the smoothing did and why, for the user; `reason`: why the input
+    /// itself was not layered.
+    fn warning(&self, reason: &NotLayered, wall_m: f64) -> String {
+        let [median, p99, max] = self.shift_m;
+        format!(
+            "not meshed in layers as given ({}), so meshed in layers on a copy smoothed by \
+             {NOISE_SMOOTHING_PASSES} passes of Taubin's filter (noise, like a scan's, folds the layers): \
+             the copy lies {median:.2e} m from the input at the median vertex, {p99:.2e} m at the 99th \
+             percentile, {max:.2e} m at most (wall {wall_m:.3e} m)",
+            not_layered_reason(reason)
+        )
+    }
+}
+
+/// [`layered`] on the `smoothed` surface, its skins' small holes closed.
+fn layered_when_smoothed(
+    repaired: &Repaired,
+    smoothed: &Smoothed,
+    diagonal: f64,
+    shape: (f64, usize),
+    sizing: LayerSizing,
+) -> Result<Layered, NotLayered> {
+    let s = &smoothed.vertices;
+    let bvh = Bvh::new(repaired.triangles.iter().map(|t| t.map(|v| s[v])).collect());
+    layered(s, &repaired.triangles, &bvh, diagonal, shape, sizing, true)
 }
 
 /// Why a thin-walled solid was stuffed with cells of its wall's size instead
 /// of meshed in layers (slower, and a warning says so).
 fn not_layered_warning(reason: &NotLayered, wall: f64) -> String {
-    let why = match reason {
+    format!(
+        "thin walls (mean thickness 2V/A = {wall:.3e} m), not meshed in layers across the wall: {}; \
+         filled with cells of the wall's size instead (more tets, slower)",
+        not_layered_reason(reason)
+    )
+}
+
+/// Why a surface was not meshed in layers, in a user's words.
+fn not_layered_reason(reason: &NotLayered) -> String {
+    match reason {
         NotLayered::Unpaired { paired_fraction } => {
             format!("only {:.0} % of its surface lies in walls with a facing side", 100.0 * paired_fraction)
         }
@@ -473,11 +581,7 @@ fn not_layered_warning(reason: &NotLayered, wall: f64) -> String {
             format!("its walls hold only {:.1} % of its volume (a thick part)", 100.0 * ratio)
         }
         NotLayered::TooMany { .. } => "it needs too many layered tets".into(),
-    };
-    format!(
-        "thin walls (mean thickness 2V/A = {wall:.3e} m), not meshed in layers across the wall: {why}; \
-         filled with cells of the wall's size instead (more tets, slower)"
-    )
+    }
 }
 
 /// The uniform (or graded) isosurface stuffing of the surface at cell `h0`,

@@ -9,16 +9,13 @@
 //! 1 % (`modal_mesh::MAX_CURVED_CELL_PER_WALL`).
 //!
 //! Steps ([`layered`]):
-//! 1. **Pairs.** From each triangle's centroid a ray along −n: the triangle
-//!    is paired when the ray leaves the solid, within [`MAX_WALL_FRACTION`]
-//!    of the diagonal, through an opposite-facing triangle (`n·n' < −½`).
-//! 2. **Skins.** Paired triangles joined by manifold edges. Skins that face
-//!    each other must fall on two sides (outer ↔ inner), each sending
-//!    [`MIN_PARTNER_SHARE`] of its rays to the other side; one side of each
-//!    group must be a single skin (the master), and each group one closed
-//!    surface ([`master_sides`]). A skin that faces itself (a handle's tube)
-//!    means the body is no shell, and stuffing is used. Paired triangles
-//!    must hold [`MIN_PAIRED_AREA`] of the area (the rest are rims).
+//! 1. **Pairs** and 2. **Skins** (module `pairing`): from each triangle a
+//!    ray across the wall to an opposite-facing triangle; the paired
+//!    triangles form skins, two sides per wall, one of them a single skin
+//!    (the master). A skin that faces itself (a handle's tube) means the
+//!    body is no shell, and stuffing is used. A surface that fails any
+//!    step here is tried again smoothed, if it is only noisy (module
+//!    `smooth`, by the caller).
 //! 3. **Master skin** brought to the wall rule's edges (module
 //!    `wall_rule`): a finely tessellated skin is coarsened first (module
 //!    `coarsen`: edges shorter than [`INPUT_COLLAPSE_SHARE`] of the rule's
@@ -46,24 +43,16 @@
 //! height `t/2` below its walls' ends is not meshed: it moves the rim by at
 //! most `t/2`).
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::coarsen::{coarsen, Targets};
 use crate::geom::{add, area_vector, cross, dot, norm, orient6, scale, sub, unit, V3};
+use crate::pairing::Skins;
 use crate::stuff::edge;
 use crate::wall_rule::{bend, slender_length, EdgeLimits};
-
-/// Walls up to this fraction of the bounding-box diagonal can pair.
-pub const MAX_WALL_FRACTION: f64 = 0.1;
-
-/// Paired skins must hold at least this fraction of the surface area.
-pub const MIN_PAIRED_AREA: f64 = 0.8;
-
-/// Each skin must send at least this fraction (by area) of its rays to the other side.
-pub const MIN_PARTNER_SHARE: f64 = 0.8;
 
 /// Each tet keeps at least this fraction of its ideal-prism volume.
 pub const MIN_VOLUME_RATIO: f64 = 0.05;
@@ -147,7 +136,9 @@ pub(crate) struct LayerSizing {
 }
 
 /// Meshes the closed, outward-oriented surface (`vertices`, `triangles`,
-/// with `bvh` over the same triangles) in layers, if it is a shell (module doc).
+/// with `bvh` over the same triangles) in layers, if it is a shell (module
+/// doc); on a `noisy` (smoothed) surface the skins' small holes are closed
+/// (module `pairing`).
 pub(crate) fn layered(
     vertices: &[V3],
     triangles: &[[usize; 3]],
@@ -155,20 +146,15 @@ pub(crate) fn layered(
     diagonal: f64,
     (enclosed_volume, components): (f64, usize),
     sizing: LayerSizing,
+    noisy: bool,
 ) -> Result<Layered, NotLayered> {
-    let pairs = pair_triangles(vertices, triangles, bvh, diagonal);
-    let total_area: f64 = pairs.iter().map(|p| p.area).sum();
-    let paired_area: f64 = pairs.iter().filter(|p| p.partner.is_some()).map(|p| p.area).sum();
-    let paired_fraction = if total_area > 0.0 { paired_area / total_area } else { 0.0 };
-    if paired_fraction < MIN_PAIRED_AREA {
-        return Err(NotLayered::Unpaired { paired_fraction });
-    }
-    let (master, opposite) = master_triangles(triangles, &pairs, components)?;
-    let wall_m = median_wall(&pairs);
+    let skins = Skins::pair(vertices, triangles, bvh, diagonal, components, noisy)?;
+    let (master, opposite) = (&skins.master, &skins.opposite);
+    let wall_m = skins.median_wall();
     let master_points: Vec<V3> = master.iter().flat_map(|&t| triangles[t].map(|v| vertices[v])).collect();
     let limits = EdgeLimits::new(&sizing, wall_m, slender_length(&master_points));
     let layers = ((wall_m / limits.curved_m).round() as usize).max(1);
-    let master_area: f64 = master.iter().map(|&t| pairs[t].area).sum();
+    let master_area = skins.master_area();
     // Refined triangles ≥ area / (√3/4 · h_straight²); three tets per prism and layer.
     let estimated =
         (3.0 * layers as f64 * master_area / (0.433 * limits.straight_m * limits.straight_m)) as usize;
@@ -177,8 +163,8 @@ pub(crate) fn layered(
     }
     let opposite = Bvh::new(opposite.iter().map(|&t| triangles[t].map(|v| vertices[v])).collect());
     let layering =
-        Layering { opposite: &opposite, reach: 3.0 * max_wall(&pairs), wall_m, layers, enclosed_volume };
-    let skin = Skin::from_triangles(vertices, triangles, &master).coarsened(
+        Layering { opposite: &opposite, reach: 3.0 * skins.max_wall(), wall_m, layers, enclosed_volume };
+    let skin = Skin::from_triangles(vertices, triangles, master).coarsened(
         &limits,
         wall_m,
         INPUT_COLLAPSE_SHARE * limits.straight_m,
@@ -240,194 +226,6 @@ impl Layering<'_> {
         }
         Ok((skin, mesh))
     }
-}
-
-/// A triangle's pairing: its area, its wall thickness and the triangle its ray reached.
-#[derive(Clone, Copy, Debug)]
-struct Pair {
-    area: f64,
-    thickness: f64,
-    partner: Option<usize>,
-}
-
-/// Step 1 of the module doc, per triangle.
-fn pair_triangles(vertices: &[V3], triangles: &[[usize; 3]], bvh: &Bvh, diagonal: f64) -> Vec<Pair> {
-    let normals: Vec<V3> =
-        triangles.iter().map(|t| area_vector(vertices[t[0]], vertices[t[1]], vertices[t[2]])).collect();
-    let eps = 1e-7 * diagonal;
-    let reach = MAX_WALL_FRACTION * diagonal;
-    triangles
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let area = norm(normals[i]);
-            let n = unit(normals[i]);
-            let c = scale(add(add(vertices[t[0]], vertices[t[1]]), vertices[t[2]]), 1.0 / 3.0);
-            let from = sub(c, scale(n, eps));
-            let to = sub(c, scale(n, reach));
-            let hit =
-                bvh.first_crossing(from, to).filter(|&(_, j)| j != i && dot(n, unit(normals[j])) < -0.5);
-            match hit {
-                Some((s, j)) => Pair { area, thickness: eps + s * (reach - eps), partner: Some(j) },
-                None => Pair { area, thickness: f64::INFINITY, partner: None },
-            }
-        })
-        .collect()
-}
-
-/// Step 2: the master triangles (the master side of each group of facing
-/// skins, [`master_sides`]) and the others of the paired skins, or why there are none.
-fn master_triangles(
-    triangles: &[[usize; 3]],
-    pairs: &[Pair],
-    components: usize,
-) -> Result<(Vec<usize>, Vec<usize>), NotLayered> {
-    let skin_of = paired_components(triangles, pairs);
-    let skins = skin_of.iter().flatten().map(|&s| s + 1).max().unwrap_or(0);
-    // Area of each skin and, per skin, the area its rays send to each other skin.
-    let mut area = vec![0.0; skins];
-    let mut sent: Vec<BTreeMap<usize, f64>> = vec![BTreeMap::new(); skins];
-    for (t, p) in pairs.iter().enumerate() {
-        let (Some(s), Some(j)) = (skin_of[t], p.partner) else { continue };
-        area[s] += p.area;
-        if let Some(r) = skin_of[j] {
-            *sent[s].entry(r).or_default() += p.area;
-        }
-    }
-    let is_master = master_sides(&area, &sent, components)?;
-    let paired = (0..triangles.len()).filter(|&t| skin_of[t].is_some());
-    Ok(paired.partition(|&t| skin_of[t].is_some_and(|s| is_master[s])))
-}
-
-/// Which skins are masters. Skins that face each other (one sends at least a tenth of its
-/// area's rays to the other) must take two sides, like a wall's outer and inner skins;
-/// each skin must send [`MIN_PARTNER_SHARE`] of its area to the other side. Of each group
-/// of facing skins the master side is the one made of a single skin (the larger if both
-/// are): prisms hang from it, and a side split by an unpaired band (a bowl's foot and wall,
-/// outside) would hang its pieces apart. Every group must be one of the surface's
-/// `components`: two groups in one closed surface would be two bodies.
-fn master_sides(
-    area: &[f64],
-    sent: &[BTreeMap<usize, f64>],
-    components: usize,
-) -> Result<Vec<bool>, NotLayered> {
-    let skins = area.len();
-    let mut facing: Vec<Vec<usize>> = vec![Vec::new(); skins];
-    for s in 0..skins {
-        for (&r, &a) in &sent[s] {
-            if a >= 0.1 * area[s] {
-                facing[s].push(r);
-                facing[r].push(s);
-            }
-        }
-    }
-    let mut side: Vec<Option<(usize, bool)>> = vec![None; skins];
-    let mut groups = 0;
-    for start in 0..skins {
-        if side[start].is_some() {
-            continue;
-        }
-        side[start] = Some((groups, false));
-        let mut stack = vec![start];
-        while let Some(s) = stack.pop() {
-            let (g, here) = side[s].ok_or(NotLayered::Skins)?;
-            for &r in &facing[s] {
-                match side[r] {
-                    None => {
-                        side[r] = Some((g, !here));
-                        stack.push(r);
-                    }
-                    Some((_, there)) if there == here => return Err(NotLayered::Skins),
-                    Some(_) => {}
-                }
-            }
-        }
-        groups += 1;
-    }
-    if groups != components {
-        return Err(NotLayered::Skins);
-    }
-    let side: Vec<(usize, bool)> =
-        side.into_iter().map(|x| x.ok_or(NotLayered::Skins)).collect::<Result<_, _>>()?;
-    for s in 0..skins {
-        let opposite: f64 = sent[s].iter().filter(|(&r, _)| side[r].1 != side[s].1).map(|(_, &a)| a).sum();
-        if opposite < MIN_PARTNER_SHARE * area[s] {
-            return Err(NotLayered::Skins);
-        }
-    }
-    // Per group and side: skin count and area.
-    let mut count = vec![[0usize; 2]; groups];
-    let mut total = vec![[0.0f64; 2]; groups];
-    for s in 0..skins {
-        let (g, b) = side[s];
-        count[g][b as usize] += 1;
-        total[g][b as usize] += area[s];
-    }
-    let master_side: Vec<bool> = (0..groups)
-        .map(|g| match count[g] {
-            [1, 1] => Ok(total[g][1] > total[g][0]),
-            [1, _] => Ok(false),
-            [_, 1] => Ok(true),
-            _ => Err(NotLayered::Skins),
-        })
-        .collect::<Result<_, _>>()?;
-    Ok(side.iter().map(|&(g, b)| b == master_side[g]).collect())
-}
-
-/// Connected components of the paired triangles over manifold edges.
-fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usize>> {
-    let mut by_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            by_edge.entry(edge(a, b)).or_default().push(t);
-        }
-    }
-    let mut skin_of: Vec<Option<usize>> = vec![None; triangles.len()];
-    let mut next = 0;
-    for start in 0..triangles.len() {
-        if pairs[start].partner.is_none() || skin_of[start].is_some() {
-            continue;
-        }
-        skin_of[start] = Some(next);
-        let mut stack = vec![start];
-        while let Some(t) = stack.pop() {
-            for k in 0..3 {
-                let (a, b) = (triangles[t][k], triangles[t][(k + 1) % 3]);
-                let shared = &by_edge[&edge(a, b)];
-                if shared.len() != 2 {
-                    continue;
-                }
-                let u = if shared[0] == t { shared[1] } else { shared[0] };
-                if pairs[u].partner.is_some() && skin_of[u].is_none() {
-                    skin_of[u] = Some(next);
-                    stack.push(u);
-                }
-            }
-        }
-        next += 1;
-    }
-    skin_of
-}
-
-/// Area-weighted median thickness of the paired triangles.
-fn median_wall(pairs: &[Pair]) -> f64 {
-    let mut walls: Vec<(f64, f64)> =
-        pairs.iter().filter(|p| p.partner.is_some()).map(|p| (p.thickness, p.area)).collect();
-    walls.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let half = 0.5 * walls.iter().map(|w| w.1).sum::<f64>();
-    let mut acc = 0.0;
-    for (t, a) in &walls {
-        acc += a;
-        if acc >= half {
-            return *t;
-        }
-    }
-    walls.last().map_or(0.0, |w| w.0)
-}
-
-fn max_wall(pairs: &[Pair]) -> f64 {
-    pairs.iter().filter(|p| p.partner.is_some()).map(|p| p.thickness).fold(0.0, f64::max)
 }
 
 /// The master skin as its own triangle mesh: vertex positions, triangles
