@@ -66,6 +66,7 @@ mod lattice;
 mod mesher;
 mod pairing;
 mod read;
+mod second_try;
 pub mod shapes;
 mod shell;
 mod sizing;
