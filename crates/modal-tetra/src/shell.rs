@@ -14,8 +14,8 @@
 //!    triangles form skins, two sides per wall, one of them a single skin
 //!    (the master). A skin that faces itself (a handle's tube) means the
 //!    body is no shell, and stuffing is used. A surface that fails any
-//!    step here is tried again smoothed, if it is only noisy (module
-//!    `smooth`, by the caller).
+//!    of the steps is tried again on a smoothed copy, if that stays close
+//!    to it (module `second_try`, by the caller).
 //! 3. **Master skin** brought to the wall rule's edges (module
 //!    `wall_rule`): a finely tessellated skin is coarsened first (module
 //!    `coarsen`: edges shorter than [`INPUT_COLLAPSE_SHARE`] of the rule's
@@ -394,17 +394,18 @@ impl Skin {
             Columns::Normals => self.vertex_normals(wall),
             Columns::Closest => Vec::new(),
         };
-        (0..self.vertices.len())
+        let ends: Vec<Option<V3>> = (0..self.vertices.len())
             .into_par_iter()
             .map(|i| {
                 let v = self.vertices[i];
-                let end = match rule {
+                match rule {
                     Columns::Normals => ray_end(opposite, v, normals[i], reach),
                     Columns::Closest => opposite.closest(v).filter(|&e| norm(sub(e, v)) <= reach),
-                };
-                end.ok_or(NotLayered::Column { at: v })
+                }
             })
-            .collect()
+            .collect();
+        // The first vertex without an end, in order (the same on every run).
+        ends.into_iter().zip(&self.vertices).map(|(e, &v)| e.ok_or(NotLayered::Column { at: v })).collect()
     }
 
     /// Unit normal at each vertex: the area-weighted normal of the skin's
@@ -429,7 +430,9 @@ impl Skin {
                 nodes.push(add(v, scale(sub(e, v), k as f64 / layers as f64)));
             }
         }
-        let tets: Result<Vec<Vec<[usize; 4]>>, NotLayered> = self
+        // Every triangle's result, then the first error in triangle order: the
+        // place a warning names is the same on every run and thread count.
+        let tets: Vec<Result<Vec<[usize; 4]>, NotLayered>> = self
             .triangles
             .par_iter()
             .map(|&t| {
@@ -443,7 +446,8 @@ impl Skin {
                 Ok(out)
             })
             .collect();
-        Ok(Prisms { nodes, tets: tets?.into_iter().flatten().collect() })
+        let tets: Vec<Vec<[usize; 4]>> = tets.into_iter().collect::<Result<_, _>>()?;
+        Ok(Prisms { nodes, tets: tets.into_iter().flatten().collect() })
     }
 
     /// The step of one layer along the ideal column of triangle `t`: its own
