@@ -336,9 +336,7 @@ pub fn tetrahedralize(
     };
     // A smoothed surface is the one the curved boundary follows; the
     // deviations reported stay against the input.
-    let smoothed_bvh =
-        smoothed.map(|s| Bvh::new(repaired.triangles.iter().map(|t| t.map(|v| s[v])).collect()));
-    let follow = smoothed_bvh.as_ref().unwrap_or(&bvh);
+    let follow = smoothed.as_ref().unwrap_or(&bvh);
     let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     // A layered wall's nodes are on its skins already; snapping within a
@@ -462,7 +460,7 @@ fn try_layered(
         match smoothed.layered(repaired, diagonal, shape, sizing) {
             Ok(mesh) => {
                 warnings.push(smoothed.warning(&reason, mesh.wall_m));
-                return Ok(Some(LayeredWall { mesh, smoothed: Some(smoothed.vertices) }));
+                return Ok(Some(LayeredWall { mesh, smoothed: Some(smoothed.surface) }));
             }
             Err(NotLayered::TooMany { estimated, in_plane_m }) => {
                 return Err(too_many(estimated, in_plane_m))
@@ -478,7 +476,7 @@ fn try_layered(
 /// (its curved boundary follows that surface, not the noise).
 pub(crate) struct LayeredWall {
     mesh: Layered,
-    smoothed: Option<Vec<V3>>,
+    smoothed: Option<Bvh>,
 }
 
 /// Why a thin-walled solid was stuffed with cells of its wall's size instead

@@ -34,11 +34,14 @@ pub const CREASE_NORMAL_RADIUS_PER_WALL: f64 = 1.0 / 3.0;
 /// 6 k triangles), 0.094 and 0.152 (the corpus and 15 cm bells' lips).
 pub const MAX_SMOOTHING_SHIFT_PER_WALL: f64 = 0.1;
 
-/// The input surface's vertices after Taubin smoothing, and how far they
-/// lie from the input surface [m]: the median, the 99th percentile, the largest.
+/// The input surface's vertices after Taubin smoothing, a BVH over its
+/// triangles, and how far they lie from the input surface [m]: the median,
+/// the 99th percentile, the largest.
 pub(crate) struct Smoothed {
-    /// The smoothed vertices, on the input's triangles.
-    pub vertices: Vec<V3>,
+    vertices: Vec<V3>,
+    /// The smoothed triangles (the layers' surface and, after them, the one
+    /// the curved boundary follows).
+    pub surface: Bvh,
     shift_m: [f64; 3],
 }
 
@@ -56,7 +59,11 @@ impl Smoothed {
         shift.sort_by(f64::total_cmp);
         let at = |q: f64| shift[((shift.len() - 1) as f64 * q).round() as usize];
         let shift_m = [at(0.5), at(0.99), at(1.0)];
-        (shift_m[1] <= MAX_SMOOTHING_SHIFT_PER_WALL * wall).then_some(Smoothed { vertices, shift_m })
+        if shift_m[1] > MAX_SMOOTHING_SHIFT_PER_WALL * wall {
+            return None;
+        }
+        let surface = Bvh::new(t.iter().map(|t| t.map(|v| vertices[v])).collect());
+        Some(Smoothed { vertices, surface, shift_m })
     }
 
     /// What the smoothing did and why, for the user; `reason`: why the input
@@ -80,8 +87,6 @@ impl Smoothed {
         shape: (f64, usize),
         sizing: LayerSizing,
     ) -> Result<Layered, NotLayered> {
-        let s = &self.vertices;
-        let bvh = Bvh::new(repaired.triangles.iter().map(|t| t.map(|v| s[v])).collect());
-        layered(s, &repaired.triangles, &bvh, diagonal, shape, sizing, true)
+        layered(&self.vertices, &repaired.triangles, &self.surface, diagonal, shape, sizing, true)
     }
 }
