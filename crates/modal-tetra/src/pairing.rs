@@ -20,14 +20,14 @@
 //! than a disc of one wall's radius that borders a single skin joins it
 //! ([`close_holes`]) before the skins are formed.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::geom::{add, area_vector, dot, norm, scale, sub, unit, V3};
 use crate::shell::NotLayered;
-use crate::stuff::edge;
+use crate::stuff::{edge, edge_triangles, EdgeTriangles};
 
 /// Walls up to this fraction of the bounding-box diagonal can pair.
 pub const MAX_WALL_FRACTION: f64 = 0.1;
@@ -61,9 +61,10 @@ impl Skins {
         noisy: bool,
     ) -> Result<Skins, NotLayered> {
         let mut pairs = pair_triangles(vertices, triangles, bvh, diagonal);
+        let by_edge = edge_triangles(triangles);
         if noisy {
             let wall = median_wall(&pairs);
-            close_holes(triangles, &mut pairs, std::f64::consts::PI * wall * wall);
+            close_holes(triangles, &by_edge, &mut pairs, std::f64::consts::PI * wall * wall);
         }
         let total_area: f64 = pairs.iter().map(|p| p.area).sum();
         let paired_area: f64 = pairs.iter().filter(|p| p.partner.is_some()).map(|p| p.area).sum();
@@ -71,7 +72,7 @@ impl Skins {
         if paired_fraction < MIN_PAIRED_AREA {
             return Err(NotLayered::Unpaired { paired_fraction });
         }
-        let (master, opposite) = master_triangles(triangles, &pairs, components)?;
+        let (master, opposite) = master_triangles(triangles, &by_edge, &pairs, components)?;
         Ok(Skins { pairs, master, opposite })
     }
 
@@ -128,10 +129,11 @@ fn pair_triangles(vertices: &[V3], triangles: &[[usize; 3]], bvh: &Bvh, diagonal
 /// skins, [`master_sides`]) and the others of the paired skins, or why there are none.
 fn master_triangles(
     triangles: &[[usize; 3]],
+    by_edge: &EdgeTriangles,
     pairs: &[Pair],
     components: usize,
 ) -> Result<(Vec<usize>, Vec<usize>), NotLayered> {
-    let skin_of = paired_components(triangles, pairs);
+    let skin_of = paired_components(triangles, by_edge, pairs);
     let skins = skin_of.iter().flatten().map(|&s| s + 1).max().unwrap_or(0);
     // Area of each skin and, per skin, the area its rays send to each other skin.
     let mut area = vec![0.0; skins];
@@ -227,9 +229,8 @@ fn master_sides(
 /// whose paired neighbours all lie in one skin joins that skin: its
 /// triangles take the wall and partner of the lowest-numbered of those
 /// neighbours. A rim band borders two skins and stays unpaired.
-fn close_holes(triangles: &[[usize; 3]], pairs: &mut [Pair], max_area: f64) {
-    let skin_of = paired_components(triangles, pairs);
-    let by_edge = edge_triangles(triangles);
+fn close_holes(triangles: &[[usize; 3]], by_edge: &EdgeTriangles, pairs: &mut [Pair], max_area: f64) {
+    let skin_of = paired_components(triangles, by_edge, pairs);
     let mut seen = vec![false; triangles.len()];
     for start in 0..triangles.len() {
         if pairs[start].partner.is_some() || seen[start] {
@@ -238,7 +239,7 @@ fn close_holes(triangles: &[[usize; 3]], pairs: &mut [Pair], max_area: f64) {
         seen[start] = true;
         let (mut patch, mut stack, mut border) = (vec![start], vec![start], Vec::new());
         while let Some(t) = stack.pop() {
-            for u in manifold_neighbours(triangles, &by_edge, t) {
+            for u in manifold_neighbours(triangles, by_edge, t) {
                 if pairs[u].partner.is_some() {
                     border.push(u);
                 } else if !seen[u] {
@@ -261,8 +262,11 @@ fn close_holes(triangles: &[[usize; 3]], pairs: &mut [Pair], max_area: f64) {
 }
 
 /// Connected components of the paired triangles over manifold edges.
-fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usize>> {
-    let by_edge = edge_triangles(triangles);
+fn paired_components(
+    triangles: &[[usize; 3]],
+    by_edge: &EdgeTriangles,
+    pairs: &[Pair],
+) -> Vec<Option<usize>> {
     let mut skin_of: Vec<Option<usize>> = vec![None; triangles.len()];
     let mut next = 0;
     for start in 0..triangles.len() {
@@ -272,7 +276,7 @@ fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usi
         skin_of[start] = Some(next);
         let mut stack = vec![start];
         while let Some(t) = stack.pop() {
-            for u in manifold_neighbours(triangles, &by_edge, t) {
+            for u in manifold_neighbours(triangles, by_edge, t) {
                 if pairs[u].partner.is_some() && skin_of[u].is_none() {
                     skin_of[u] = Some(next);
                     stack.push(u);
@@ -284,21 +288,10 @@ fn paired_components(triangles: &[[usize; 3]], pairs: &[Pair]) -> Vec<Option<usi
     skin_of
 }
 
-/// The triangles on each edge.
-fn edge_triangles(triangles: &[[usize; 3]]) -> HashMap<(usize, usize), Vec<usize>> {
-    let mut by_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            by_edge.entry(edge(tri[k], tri[(k + 1) % 3])).or_default().push(t);
-        }
-    }
-    by_edge
-}
-
 /// The triangles across the manifold edges (two triangles each) of triangle `t`.
 fn manifold_neighbours<'a>(
     triangles: &'a [[usize; 3]],
-    by_edge: &'a HashMap<(usize, usize), Vec<usize>>,
+    by_edge: &'a EdgeTriangles,
     t: usize,
 ) -> impl Iterator<Item = usize> + 'a {
     (0..3).filter_map(move |k| {

@@ -28,12 +28,11 @@
 //! Laplacian or cotangent flow (shrinking), or remesh, which would lose
 //! the input's vertices the layered mesher reads.
 
-use std::collections::HashMap;
-
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::geom::{add, area_vector, dot, scale, sub, unit, V3};
+use crate::stuff::edge_triangles;
 
 /// λ of the shrinking step.
 pub const LAMBDA: f64 = 0.5;
@@ -105,13 +104,7 @@ fn smoothing_neighbours(
     normals: &[V3],
     crease_deg: f64,
 ) -> Vec<Vec<usize>> {
-    let mut faces: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            faces.entry((a.min(b), a.max(b))).or_default().push(f);
-        }
-    }
+    let faces = edge_triangles(triangles);
     let cos_crease = crease_deg.to_radians().cos();
     let mut all: Vec<Vec<usize>> = vec![Vec::new(); count];
     let mut creases: Vec<Vec<usize>> = vec![Vec::new(); count];
@@ -142,6 +135,8 @@ fn smoothing_neighbours(
 
 #[cfg(test)]
 mod tests {
+    use std::collections::HashMap;
+
     use super::*;
     use crate::geom::norm;
 

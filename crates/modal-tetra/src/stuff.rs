@@ -49,9 +49,23 @@ pub(crate) struct Stuffed {
 
 type Edge = (usize, usize);
 
+/// The triangles on each edge ([`edge_triangles`]).
+pub(crate) type EdgeTriangles = HashMap<Edge, Vec<usize>>;
+
 /// An edge as its sorted pair of vertices (the key both its faces share).
 pub(crate) fn edge(a: usize, b: usize) -> Edge {
     (a.min(b), a.max(b))
+}
+
+/// The triangles on each edge of `triangles` (by [`edge`] key), in triangle order.
+pub(crate) fn edge_triangles(triangles: &[[usize; 3]]) -> EdgeTriangles {
+    let mut by_edge = EdgeTriangles::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            by_edge.entry(edge(tri[k], tri[(k + 1) % 3])).or_default().push(t);
+        }
+    }
+    by_edge
 }
 
 /// A vertex of an output tet: a lattice point, or the cut point of an edge.
