@@ -234,12 +234,8 @@ fn a_mesh_beyond_the_memory_guard_is_refused_before_assembly() {
     // 1 MB: less than the bar's stiffness and mass matrices alone.
     let dir = temp_dir();
     let bar = example("bar_p1.msh");
-    let limit = std::path::Path::new("0.001");
-    let run = modal_with_env(
-        dir.path(),
-        &["precompute", bar.to_str().unwrap(), "-o", "a.bank", "--no-cache", "--material", "steel"],
-        &[("MODAL_MEMORY_LIMIT_GB", limit)],
-    );
+    let args = ["precompute", bar.to_str().unwrap(), "-o", "a.bank", "--no-cache", "--material", "steel"];
+    let run = modal_within_memory(dir.path(), &args, "0.001");
     let text = run.fails_with("stiffness and mass matrices alone would need").stderr;
     assert!(text.contains("DOF") && text.contains("coarser mesh"), "{text}");
     assert!(!dir.path().join("a.bank").exists(), "no output on failure");
@@ -262,7 +258,7 @@ fn a_surface_whose_tets_cannot_fit_the_memory_guard_is_refused_before_meshing() 
         "--cell",
         "0.001",
     ];
-    let run = modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("1"))]);
+    let run = modal_within_memory(dir.path(), &args, "1");
     let text = run.fails_with("would be meshed into about").stderr;
     assert!(text.contains("memory limit of 1.0 GB") && text.contains("--cell"), "{text}");
     assert!(!dir.path().join("a.bank").exists(), "no output on failure");
@@ -278,10 +274,10 @@ fn a_mesh_whose_factor_exceeds_the_memory_guard_is_refused_before_its_matrices_a
     modal(dir.path(), &["mesh", "box", "--size", "0.05,0.05,0.05", "--h", "0.004", "-o", "cube.msh"]).ok();
     let args =
         ["precompute", "cube.msh", "-o", "a.bank", "--no-cache", "--material", "steel", "--modes", "5"];
-    let run = modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("0.3"))]);
+    let run = modal_within_memory(dir.path(), &args, "0.3");
     let text = run.fails_with("and their factor").stderr;
     assert!(text.contains("59049 DOF") && text.contains("coarser mesh"), "{text}");
     assert!(!dir.path().join("a.bank").exists(), "no output on failure");
-    modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", std::path::Path::new("1"))]).ok();
+    modal_within_memory(dir.path(), &args, "1").ok();
     assert!(dir.path().join("a.bank").exists());
 }

@@ -121,9 +121,8 @@ fn a_generated_shape_beyond_the_memory_guard_is_refused_before_it_is_generated()
     // 2 mm cells: 12 000 quadratic tets, at least 0.13 GB of matrices; the guard is 0.05 GB.
     let fine = TWO_BLOCKS.replace("element_size = 0.01", "element_size = 0.002");
     std::fs::write(dir.path().join("fine.toml"), fine).unwrap();
-    let limit = std::path::Path::new("0.05");
     let args = ["render", "fine.toml", "-o", "out/fine.wav", "--radiation", "estimate"];
-    let refused = modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", limit)]);
+    let refused = modal_within_memory(dir.path(), &args, "0.05");
     refused
         .fails_with("12000 quadratic tets")
         .fails_with("at least 0.13 GB, above the memory limit of 0.05 GB");
@@ -133,7 +132,6 @@ fn a_generated_shape_beyond_the_memory_guard_is_refused_before_it_is_generated()
     // The same guard lets the 1 cm blocks through.
     std::fs::write(dir.path().join("s.toml"), TWO_BLOCKS).unwrap();
     let args = ["render", "s.toml", "-o", "out/s.wav", "--radiation", "estimate"];
-    modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", limit)]).ok();
-    let bad = std::path::Path::new("lots");
-    modal_with_env(dir.path(), &args, &[("MODAL_MEMORY_LIMIT_GB", bad)]).fails_with("MODAL_MEMORY_LIMIT_GB");
+    modal_within_memory(dir.path(), &args, "0.05").ok();
+    modal_within_memory(dir.path(), &args, "lots").fails_with("MODAL_MEMORY_LIMIT_GB");
 }

@@ -17,6 +17,11 @@ pub fn modal(dir: &Path, args: &[&str]) -> Run {
     modal_with_env(dir, args, &[])
 }
 
+/// [`modal`] under a memory guard of `gb` GB (`MODAL_MEMORY_LIMIT_GB`, as given).
+pub fn modal_within_memory(dir: &Path, args: &[&str], gb: &str) -> Run {
+    modal_with_env(dir, args, &[("MODAL_MEMORY_LIMIT_GB", Path::new(gb))])
+}
+
 /// [`modal`] with extra environment variables.
 pub fn modal_with_env(dir: &Path, args: &[&str], env: &[(&str, &Path)]) -> Run {
     let output = Command::new(env!("CARGO_BIN_EXE_modal"))
