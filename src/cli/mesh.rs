@@ -33,6 +33,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
             let summary = serde_json::json!({
                 "out": out.display().to_string(),
                 "input_triangles": report.triangles,
+                "cavities": report.cavities,
                 "tets": r.tets,
                 "nodes": r.nodes,
                 "cell_m": r.cell_m,
@@ -66,6 +67,9 @@ pub fn run(shape: MeshShape) -> Result<()> {
                     r.surface_volume_m3,
                     r.max_surface_deviation_m
                 );
+                if report.cavities > 0 {
+                    println!("hollow: {} inner wall(s) facing inward bound cavities", report.cavities);
+                }
                 if r.wall_layers > 0 {
                     println!(
                         "thin shell: {} layer(s) of tets across its {:.3e} m wall, edges along it up to {:.3e} m",

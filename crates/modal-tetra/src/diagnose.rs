@@ -5,11 +5,14 @@
 //! classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
 //! or more), then orient triangles consistently across manifold edges per
 //! connected component (breadth-first) and flip a component whose signed
-//! volume is negative. The repaired triangles feed the winding number.
+//! volume is negative, except the inner walls of hollow objects, which keep
+//! facing inward (module `nesting`). The repaired triangles feed the
+//! winding number.
 
 use std::collections::HashMap;
 
 use crate::geom::{cross, dot, norm, sub, V3};
+use crate::nesting::{nest, Component};
 use crate::TriSurface;
 
 /// What was wrong with an input surface (all counts refer to the input).
@@ -41,8 +44,12 @@ pub struct SurfaceReport {
     pub flipped_faces: usize,
     /// Edge-connected components (after welding).
     pub components: usize,
-    /// Σ |signed volume| of the oriented components (m³) (exact for closed
-    /// surfaces; overlapping parts are counted twice).
+    /// Closed components inside another closed one that face the other way
+    /// in the input: inner walls of hollow objects, kept facing inward.
+    pub cavities: usize,
+    /// Signed volume of the oriented components summed (m³): outer parts
+    /// add, cavities subtract (exact for closed surfaces; overlapping parts
+    /// are counted twice).
     pub enclosed_volume_m3: f64,
     /// Human-readable warnings, e.g. the unit hint pointing to `--scale`.
     pub warnings: Vec<String>,
@@ -176,12 +183,11 @@ fn orient(vertices: &[V3], triangles: &mut [[usize; 3]], report: &mut SurfaceRep
     }
     let mut flip = vec![false; triangles.len()];
     let mut seen = vec![false; triangles.len()];
-    let mut flipped = 0;
+    let mut components = Vec::new();
     for seed in 0..triangles.len() {
         if seen[seed] {
             continue;
         }
-        report.components += 1;
         seen[seed] = true;
         let mut component = vec![seed];
         let mut next = 0;
@@ -198,16 +204,53 @@ fn orient(vertices: &[V3], triangles: &mut [[usize; 3]], report: &mut SurfaceRep
         }
         let volume = signed_volume(vertices, triangles, &component, &flip);
         let reverse = volume < 0.0;
-        report.enclosed_volume_m3 += volume.abs();
-        for &t in &component {
-            flip[t] ^= reverse;
-            if flip[t] {
-                triangles[t].swap(1, 2);
-                flipped += 1;
-            }
+        component.iter().for_each(|&t| flip[t] ^= reverse);
+        let turned = component.iter().filter(|&&t| flip[t]).count();
+        let closed = component.iter().all(|&t| adjacency[t].len() == 3);
+        components.push(Component {
+            closed,
+            volume: volume.abs(),
+            given_outward: 2 * turned <= component.len(),
+            triangles: component,
+        });
+    }
+    report.components = components.len();
+    let outward: Vec<[usize; 3]> =
+        triangles.iter().zip(&flip).map(|(t, &f)| if f { [t[0], t[2], t[1]] } else { *t }).collect();
+    let nesting = nest(vertices, &outward, &components);
+    for (c, component) in components.iter().enumerate() {
+        let inward = nesting.inward[c];
+        report.enclosed_volume_m3 += if inward { -component.volume } else { component.volume };
+        report.cavities += usize::from(inward);
+        component.triangles.iter().for_each(|&t| flip[t] ^= inward);
+    }
+    if let Some(&first) = nesting.same_facing.first() {
+        report.warnings.push(same_facing_warning(
+            vertices,
+            &outward,
+            &components[first],
+            nesting.same_facing.len(),
+        ));
+    }
+    let mut flipped = 0;
+    for (t, f) in triangles.iter_mut().zip(flip) {
+        if f {
+            t.swap(1, 2);
+            flipped += 1;
         }
     }
     flipped
+}
+
+/// Says that closed parts inside others were kept solid, and how a cavity is marked.
+fn same_facing_warning(vertices: &[V3], triangles: &[[usize; 3]], first: &Component, count: usize) -> String {
+    let p = vertices[triangles[first.triangles[0]][0]];
+    format!(
+        "{count} closed part(s) lie inside another closed part and face the same way, first near ({:.4}, {:.4}, \
+         {:.4}) m: meshed as solid; if a part is the inner wall of a hollow object, orient its triangles inward \
+         (towards the cavity)",
+        p[0], p[1], p[2]
+    )
 }
 
 /// Signed volume of a component under the given flips, about its first vertex.

@@ -64,6 +64,7 @@ mod geom;
 mod graded;
 mod lattice;
 mod mesher;
+mod nesting;
 mod pairing;
 mod read;
 mod second_try;

@@ -440,8 +440,9 @@ fn try_layered(
         max_tets: options.max_tets,
     };
     let volume_m3 = repaired.report.enclosed_volume_m3;
-    let components = repaired.report.components;
-    let shape = (volume_m3, components);
+    // A hollow body's outer and inner walls are two components of one body.
+    let bodies = repaired.report.components - repaired.report.cavities;
+    let shape = (volume_m3, bodies);
     let too_many = |estimated: usize, in_plane_m: f64| {
         // Tets go as cell⁻² here; the error's hint assumes cell⁻³.
         let ratio = estimated as f64 / options.max_tets as f64;

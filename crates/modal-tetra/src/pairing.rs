@@ -50,14 +50,14 @@ pub(crate) struct Skins {
 
 impl Skins {
     /// Steps 1–2 of the module doc on the closed, outward surface
-    /// (`bvh` over the same triangles) of `components` closed parts, with
+    /// (`bvh` over the same triangles) of `bodies` closed solids, with
     /// the small holes of a `noisy` surface closed.
     pub fn pair(
         vertices: &[V3],
         triangles: &[[usize; 3]],
         bvh: &Bvh,
         diagonal: f64,
-        components: usize,
+        bodies: usize,
         noisy: bool,
     ) -> Result<Skins, NotLayered> {
         let mut pairs = pair_triangles(vertices, triangles, bvh, diagonal);
@@ -72,7 +72,7 @@ impl Skins {
         if paired_fraction < MIN_PAIRED_AREA {
             return Err(NotLayered::Unpaired { paired_fraction });
         }
-        let (master, opposite) = master_triangles(triangles, &by_edge, &pairs, components)?;
+        let (master, opposite) = master_triangles(triangles, &by_edge, &pairs, bodies)?;
         Ok(Skins { pairs, master, opposite })
     }
 
@@ -131,7 +131,7 @@ fn master_triangles(
     triangles: &[[usize; 3]],
     by_edge: &EdgeTriangles,
     pairs: &[Pair],
-    components: usize,
+    bodies: usize,
 ) -> Result<(Vec<usize>, Vec<usize>), NotLayered> {
     let skin_of = paired_components(triangles, by_edge, pairs);
     let skins = skin_of.iter().flatten().map(|&s| s + 1).max().unwrap_or(0);
@@ -145,7 +145,7 @@ fn master_triangles(
             *sent[s].entry(r).or_default() += p.area;
         }
     }
-    let is_master = master_sides(&area, &sent, components)?;
+    let is_master = master_sides(&area, &sent, bodies)?;
     let paired = (0..triangles.len()).filter(|&t| skin_of[t].is_some());
     Ok(paired.partition(|&t| skin_of[t].is_some_and(|s| is_master[s])))
 }
@@ -156,12 +156,9 @@ fn master_triangles(
 /// of facing skins the master side is the one made of a single skin (the larger if both
 /// are): prisms hang from it, and a side split by an unpaired band (a bowl's foot and wall,
 /// outside) would hang its pieces apart. Every group must be one of the surface's
-/// `components`: two groups in one closed surface would be two bodies.
-fn master_sides(
-    area: &[f64],
-    sent: &[BTreeMap<usize, f64>],
-    components: usize,
-) -> Result<Vec<bool>, NotLayered> {
+/// `bodies` (closed solids; a hollow one has an outer and an inner wall): two groups in one
+/// body would be two bodies.
+fn master_sides(area: &[f64], sent: &[BTreeMap<usize, f64>], bodies: usize) -> Result<Vec<bool>, NotLayered> {
     let skins = area.len();
     let mut facing: Vec<Vec<usize>> = vec![Vec::new(); skins];
     for s in 0..skins {
@@ -195,7 +192,7 @@ fn master_sides(
         }
         groups += 1;
     }
-    if groups != components {
+    if groups != bodies {
         return Err(NotLayered::Skins);
     }
     let side: Vec<(usize, bool)> =

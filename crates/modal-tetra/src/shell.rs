@@ -144,11 +144,11 @@ pub(crate) fn layered(
     triangles: &[[usize; 3]],
     bvh: &Bvh,
     diagonal: f64,
-    (enclosed_volume, components): (f64, usize),
+    (enclosed_volume, bodies): (f64, usize),
     sizing: LayerSizing,
     noisy: bool,
 ) -> Result<Layered, NotLayered> {
-    let skins = Skins::pair(vertices, triangles, bvh, diagonal, components, noisy)?;
+    let skins = Skins::pair(vertices, triangles, bvh, diagonal, bodies, noisy)?;
     let (master, opposite) = (&skins.master, &skins.opposite);
     let wall_m = skins.median_wall();
     let master_points: Vec<V3> = master.iter().flat_map(|&t| triangles[t].map(|v| vertices[v])).collect();
