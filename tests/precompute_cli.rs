@@ -265,6 +265,37 @@ fn a_surface_whose_tets_cannot_fit_the_memory_guard_is_refused_before_meshing() 
 }
 
 #[test]
+fn a_default_surface_mesh_beyond_the_memory_guard_is_coarsened_to_fit_and_not_cached() {
+    // The demo bowl at its default sizes needs ≈ 0.6 GB; under a 0.3 GB guard it was
+    // refused (a wine glass on a 24 GB machine: a minute of meshing and assembly, then
+    // refused for its 32 GB factor). Now the first level is coarsened until it fits,
+    // said in a warning, and the bank, not the request's answer, is not cached.
+    let dir = temp_dir();
+    let bowl = example("bowl.obj");
+    let bowl = bowl.to_str().unwrap();
+    let base = ["precompute", bowl, "--material", "glass", "--modes", "6", "--json"];
+    let at_defaults =
+        modal(dir.path(), &[&base[..], &["-o", "d.bank", "--no-cache", "--accuracy", "off"]].concat());
+    let at_defaults = at_defaults.ok().json();
+    let cached = ["-o", "a.bank", "--cache-dir", "cache"];
+    let run = modal_within_memory(dir.path(), &[&base[..], &cached[..]].concat(), "0.3").ok();
+    let warning =
+        run.stderr.lines().find(|l| l.contains("above the memory limit of 0.3 GB")).unwrap_or_default();
+    assert!(warning.contains("element size ×") && warning.contains("not cached"), "{}", run.stderr);
+    let fitted = run.json();
+    let dofs = |j: &Value| j["dofs"].as_u64().unwrap();
+    assert!(dofs(&fitted) < dofs(&at_defaults), "{} DOF against {}", dofs(&fitted), dofs(&at_defaults));
+    // A coarser mesh of the same bowl, with its error said.
+    for (mode, reference) in fitted["modes"].as_array().unwrap().iter().zip(frequencies(&at_defaults)) {
+        let f = mode["frequency_hz"].as_f64().unwrap();
+        assert!((f / reference - 1.0).abs() < 0.05, "{f} Hz against {reference} Hz at the defaults");
+        assert!(mode["error_estimate_pct"].as_f64().is_some_and(|e| e > 0.0), "{mode}");
+    }
+    let again = modal_within_memory(dir.path(), &[&base[..], &cached[..]].concat(), "0.3").ok();
+    assert_eq!(again.json()["cached"], Value::Bool(false), "a coarsened bank is not served from the cache");
+}
+
+#[test]
 fn a_mesh_whose_factor_exceeds_the_memory_guard_is_refused_before_its_matrices_are_assembled() {
     // A 5 cm cube at 4 mm, 59 k DOF: K and M ≈ 0.2 GB fit 0.3 GB, their factor (≈ 0.4 GB)
     // does not. Refused from the symbolic analysis of the pattern, before the values exist

@@ -30,7 +30,12 @@ fn describe(stage: &Stage) -> String {
         Stage::Assemble { dofs } => format!("assembling K and M ({dofs} DOF)"),
         Stage::Solve(what) => format!("eigen solve: {what}"),
         Stage::Store => "storing the bank in the cache".into(),
-        Stage::Level { index: 0, .. } => "level 0 (requested element size)".into(),
+        Stage::Level { index: 0, size_factor } if *size_factor == 1.0 => {
+            "level 0 (requested element size)".into()
+        }
+        Stage::Level { index: 0, size_factor } => {
+            format!("level 0 (element sizes x {size_factor:.2}, to fit the memory limit)")
+        }
         Stage::Level { index: 1, size_factor } => {
             format!("level 1 (element sizes x {size_factor:.2}) for the error estimate")
         }

@@ -89,6 +89,57 @@ impl Default for AccuracyTarget {
     }
 }
 
+/// At most this many coarser first levels are tried when the default one does not fit
+/// the memory guard ([`within_memory`]).
+pub const MEMORY_RETRIES: usize = 3;
+
+/// Margin on the memory overrun when the first level is coarsened to fit.
+const MEMORY_MARGIN: f64 = 1.25;
+
+/// Runs `attempt` on the request's own discretization (`None`) and, when that is the
+/// tool's default (a surface mesh without `--cell`) and the solve is refused for the
+/// memory guard, on element sizes × `f` (`Some(LevelSize::Factor(f))`), up to
+/// [`MEMORY_RETRIES`] times: the defaults must give an answer, not a refusal after a
+/// minute of meshing (a glass of 1.5 mm wall on a stem: 1.9 M DOF, a 32 GB factor). The
+/// factor comes from the overrun by the module doc's model, memory ∝ s⁻⁴, with
+/// [`MEMORY_MARGIN`]. Returns the result and the level it was solved at; the warning
+/// says what was coarsened and why.
+pub(crate) fn within_memory<T>(
+    request: &Request,
+    warnings: &mut Vec<String>,
+    mut attempt: impl FnMut(Option<LevelSize>) -> Result<T, PrecomputeError>,
+) -> Result<(T, Option<LevelSize>), PrecomputeError> {
+    let adjustable = request.surface.cell.is_none() && remeshable(&request.source);
+    let (mut level, mut factor, mut first_overrun) = (None, 1.0, None);
+    for retry in 0.. {
+        match attempt(level) {
+            Ok(result) => {
+                if let Some((needed, limit)) = first_overrun {
+                    warnings.push(format!(
+                        "the mesh at the default element sizes needs ≈ {:.1} GB, above the memory limit of {:.1} GB: \
+                         meshed with every element size × {factor:.2} instead, so expect larger errors than at the \
+                         defaults (the error estimate says how large), and the bank is not cached; more memory \
+                         (MODAL_MEMORY_LIMIT_GB) or --cell decide otherwise",
+                        needed as f64 / 1e9,
+                        limit as f64 / 1e9
+                    ));
+                }
+                return Ok((result, level));
+            }
+            Err(err) => match err.memory_overrun() {
+                Some((needed, limit)) if adjustable && retry < MEMORY_RETRIES && limit > 0 => {
+                    first_overrun.get_or_insert((needed, limit));
+                    let overrun = needed as f64 / limit as f64;
+                    factor *= (MEMORY_MARGIN * overrun).powf(0.25).max(1.1);
+                    level = Some(LevelSize::Factor(factor));
+                }
+                _ => return Err(err),
+            },
+        }
+    }
+    unreachable!("the loop returns")
+}
+
 /// True when the source can be meshed at other sizes (a surface mesh file).
 pub fn remeshable(source: &MeshSource) -> bool {
     matches!(source, MeshSource::File(path) if is_surface_file(path))
@@ -121,9 +172,15 @@ fn solve_level(
     key: &str,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Level, PrecomputeError> {
-    progress(Stage::Level { index, size_factor });
-    let start = std::time::Instant::now();
     let level = base.map(|b| b.scaled(size_factor));
+    // A factor level says its sizes against the defaults (a first level coarsened for
+    // memory included); a cell level against the first level's cell.
+    let shown = match level {
+        Some(LevelSize::Factor(f)) => f,
+        _ => size_factor,
+    };
+    progress(Stage::Level { index, size_factor: shown });
+    let start = std::time::Instant::now();
     let (assembled, analysis) = assemble_and_analyze(wide, true, level, progress)?;
     let (bank, memory) = solve_bank(wide, &assembled, analysis, key.to_string(), progress)?;
     let level_cell = match level {
@@ -154,19 +211,22 @@ fn widened(request: &Request) -> Request {
 }
 
 /// Solves `request` (a surface mesh) on as many levels as `target` needs (see the
-/// module docs) and returns the finest bank with its per-mode estimate, plus warnings.
+/// module docs) and returns the finest bank with its per-mode estimate, warnings, and
+/// whether the first level was coarsened to fit the memory guard ([`within_memory`]).
 pub(crate) fn solve_to_accuracy(
     request: &Request,
     target: &AccuracyTarget,
     key: &str,
     progress: &mut dyn FnMut(Stage),
-) -> Result<(ModeBank, Vec<String>), PrecomputeError> {
+) -> Result<(ModeBank, Vec<String>, bool), PrecomputeError> {
     let wide = widened(request);
     let mut warnings = Vec::new();
-    let mut fine = solve_level(&wide, 0, None, 1.0, key, progress)?;
+    let (mut fine, first) =
+        within_memory(request, &mut warnings, |level| solve_level(&wide, 0, level, 1.0, key, progress))?;
+    let coarsened = first.is_some();
     warnings.append(&mut fine.warnings);
     let base = if fine.layered {
-        Some(LevelSize::Factor(1.0))
+        Some(first.unwrap_or(LevelSize::Factor(1.0)))
     } else {
         Some(fine.cell_m).filter(|c| c.is_finite() && *c > 0.0).map(LevelSize::Cell)
     };
@@ -176,7 +236,7 @@ pub(crate) fn solve_to_accuracy(
             warnings.push(format!(
                 "no error estimate: the coarser level (element sizes × {COARSE_FACTOR}) failed: {err}"
             ));
-            return Ok((trim(&fine.bank, request, None).0, warnings));
+            return Ok((trim(&fine.bank, request, None).0, warnings, coarsened));
         }
     };
     // Wall time of the levels solved so far (the time budget's clock).
@@ -202,7 +262,7 @@ pub(crate) fn solve_to_accuracy(
         bank.info.error_estimate_method = est.method(fine.dofs, coarse.dofs);
         let worst = kept.worst_of_first(target.modes);
         if worst.is_some_and(|w| w <= target.target_pct) {
-            return Ok((bank, warnings));
+            return Ok((bank, warnings, coarsened));
         }
         let reached = describe_worst(worst, target);
         // The size that would reach the target by the estimate's own model.
@@ -215,7 +275,7 @@ pub(crate) fn solve_to_accuracy(
                 cell * wanted.min(MAX_STEP),
                 target.target_pct
             ));
-            return Ok((bank, warnings));
+            return Ok((bank, warnings, coarsened));
         }
         let guard = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
         let next = NextLevel { memory: fine.memory, seconds: fine.seconds, spent, step };
@@ -235,7 +295,7 @@ pub(crate) fn solve_to_accuracy(
                 Stop::Refinements => format!("stopped after {MAX_REFINEMENTS} refinements"),
             };
             warnings.push(format!("{reached} ({} DOF): {why}", fine.dofs));
-            return Ok((bank, warnings));
+            return Ok((bank, warnings, coarsened));
         }
         match solve_level(&wide, refinement + 2, base, fine.size_factor * step, key, progress) {
             Ok(mut finer) => {
@@ -246,7 +306,7 @@ pub(crate) fn solve_to_accuracy(
             Err(
                 err @ (PrecomputeError::Eigen(_)
                 | PrecomputeError::Tetra(_)
-                | PrecomputeError::Memory(_)
+                | PrecomputeError::Memory { .. }
                 | PrecomputeError::Fem(modal_fem::FemError::TooLarge { .. })),
             ) => {
                 warnings.push(format!(
@@ -254,7 +314,7 @@ pub(crate) fn solve_to_accuracy(
                     fine.dofs,
                     fine.cell_m * step
                 ));
-                return Ok((bank, warnings));
+                return Ok((bank, warnings, coarsened));
             }
             Err(err) => return Err(err),
         }

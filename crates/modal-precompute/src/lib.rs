@@ -73,6 +73,30 @@ pub enum PrecomputeError {
     #[error("{0}")]
     Invalid(String),
     /// The mesh's solve cannot fit the memory guard (found before the work).
-    #[error("{0}")]
-    Memory(String),
+    #[error("{message}")]
+    Memory {
+        /// What needs how much, and what to do.
+        message: String,
+        /// The least memory the solve would hold [bytes].
+        needed_bytes: u64,
+        /// The memory guard [bytes].
+        limit_bytes: u64,
+    },
+}
+
+impl PrecomputeError {
+    /// `(needed, limit)` [bytes] when the solve was refused for the memory
+    /// guard (here, in the assembly's pattern, or in the eigensolver's plan).
+    pub fn memory_overrun(&self) -> Option<(u64, u64)> {
+        match self {
+            PrecomputeError::Memory { needed_bytes, limit_bytes, .. } => Some((*needed_bytes, *limit_bytes)),
+            PrecomputeError::Fem(modal_fem::FemError::TooLarge { needed_bytes, limit_bytes, .. }) => {
+                Some((*needed_bytes, *limit_bytes))
+            }
+            PrecomputeError::Eigen(modal_eigen::EigenError::MemoryLimit { estimated, limit }) => {
+                Some((*estimated, *limit))
+            }
+            _ => None,
+        }
+    }
 }

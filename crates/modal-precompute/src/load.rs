@@ -107,12 +107,17 @@ impl TetBudget {
     }
 
     fn refusal(&self, estimated: u64) -> PrecomputeError {
-        PrecomputeError::Memory(format!(
-            "the surface would be meshed into about {estimated} tets, whose stiffness, mass and factor need at least \
-             {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
-            Self::min_bytes(estimated) as f64 / 1e9,
-            self.limit_bytes as f64 / 1e9
-        ))
+        let needed_bytes = Self::min_bytes(estimated);
+        PrecomputeError::Memory {
+            message: format!(
+                "the surface would be meshed into about {estimated} tets, whose stiffness, mass and factor need at \
+                 least {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
+                needed_bytes as f64 / 1e9,
+                self.limit_bytes as f64 / 1e9
+            ),
+            needed_bytes,
+            limit_bytes: self.limit_bytes,
+        }
     }
 }
 

@@ -237,13 +237,17 @@ fn refuse_beyond_memory(
     if matrices_bytes + factor_bytes <= limit {
         return Ok(());
     }
-    Err(PrecomputeError::Memory(format!(
-        "the mesh has {dofs} DOF: its stiffness and mass matrices need ≈ {:.1} GB and their factor ≈ {:.1} GB, above \
-         the memory limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
-        matrices_bytes as f64 / 1e9,
-        factor_bytes as f64 / 1e9,
-        limit as f64 / 1e9
-    )))
+    Err(PrecomputeError::Memory {
+        message: format!(
+            "the mesh has {dofs} DOF: its stiffness and mass matrices need ≈ {:.1} GB and their factor ≈ {:.1} GB, \
+             above the memory limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
+            matrices_bytes as f64 / 1e9,
+            factor_bytes as f64 / 1e9,
+            limit as f64 / 1e9
+        ),
+        needed_bytes: matrices_bytes + factor_bytes,
+        limit_bytes: limit,
+    })
 }
 
 /// Part ids for a mesh whose first nodes are those of the checked mesh and
@@ -284,23 +288,33 @@ pub fn precompute(
             Err(err) => warnings.push(format!("ignoring a damaged cache entry ({err}); recomputing")),
         }
     }
-    let bank = match (&request.accuracy, crate::levels::remeshable(&request.source)) {
+    let (bank, coarsened) = match (&request.accuracy, crate::levels::remeshable(&request.source)) {
         (Some(target), true) => {
-            let (bank, level_warnings) = crate::levels::solve_to_accuracy(request, target, &key, progress)?;
+            let (bank, level_warnings, coarsened) =
+                crate::levels::solve_to_accuracy(request, target, &key, progress)?;
             warnings.extend(level_warnings);
-            bank
+            (bank, coarsened)
         }
         (accuracy, remeshable) => {
-            let (assembled, analysis) = assemble_and_analyze(request, true, None, progress)?;
-            warnings.extend(assembled.warnings.iter().cloned());
+            let mut level_warnings = Vec::new();
+            let ((bank, assembled_warnings), level) =
+                crate::levels::within_memory(request, &mut level_warnings, |level| {
+                    let (assembled, analysis) = assemble_and_analyze(request, true, level, progress)?;
+                    let bank = solve_bank(request, &assembled, analysis, key.clone(), progress)?.0;
+                    Ok((bank, assembled.warnings))
+                })?;
+            warnings.extend(assembled_warnings);
+            warnings.extend(level_warnings);
             if accuracy.is_some() && !remeshable {
                 warnings.push(crate::levels::PRESCRIBED_NOTE.into());
             }
-            solve_bank(request, &assembled, analysis, key.clone(), progress)?.0
+            (bank, level.is_some())
         }
     };
     warnings.extend(residual_floor_warning(&bank));
-    if let Some(cache) = cache {
+    // A mesh coarsened for this machine's memory is not the request's answer: another run,
+    // with more memory, must not be served it from the cache.
+    if let (Some(cache), false) = (cache, coarsened) {
         progress(Stage::Store);
         if let Err(err) = cache.put(&key, &bank) {
             warnings.push(format!("could not store the result in the cache: {err}"));
