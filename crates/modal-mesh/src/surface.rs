@@ -7,6 +7,13 @@
 //! opposite normals at zero distance, where a boundary-element solve's
 //! kernels blow up (a glass mug's handle root gave matrix entries of 10³⁷).
 //!
+//! A closed component of boundary faces that encloses negative volume faces
+//! into what it encloses: the wall of a sealed cavity (a hollow ball's
+//! inside). No sound leaves a sealed cavity, so it is not surface either:
+//! kept, a boundary-element solve would also solve the cavity's air, which
+//! resonates (the interior Neumann problem: a 4.7 cm cavity at 2.4 kHz and
+//! on), and a struck point could snap to it.
+//!
 //! For a positively oriented tet `[0, 1, 2, 3]` the faces
 //! `[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]` (opposite corners 0..3) have
 //! counter-clockwise corners seen from outside, i.e. the normal
@@ -102,8 +109,53 @@ fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
     }
 }
 
+/// Clears `on_boundary` (indexed `4·tet + face`) for every face of a
+/// boundary component (faces joined by shared corner edges) whose signed
+/// volume `Σ a·(b × c)/6` is negative: a sealed cavity's wall (module doc).
+fn drop_cavity_walls(mesh: &TetMesh, on_boundary: &mut [bool]) {
+    let ids: Vec<usize> = (0..on_boundary.len()).filter(|&id| on_boundary[id]).collect();
+    let corners = |id: usize| TET_FACES[id % 4].map(|k| mesh.cells.corners(id / 4)[k]);
+    // Union–find over the faces, joined through their shared edges.
+    let mut parent: Vec<usize> = (0..ids.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut edges: Vec<((usize, usize), usize)> = Vec::with_capacity(3 * ids.len());
+    for (i, &id) in ids.iter().enumerate() {
+        let c = corners(id);
+        for k in 0..3 {
+            let (a, b) = (c[k], c[(k + 1) % 3]);
+            edges.push(((a.min(b), a.max(b)), i));
+        }
+    }
+    edges.sort_unstable();
+    for run in edges.chunk_by(|a, b| a.0 == b.0) {
+        for pair in run.windows(2) {
+            let (a, b) = (root(&mut parent, pair[0].1), root(&mut parent, pair[1].1));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    // About a boundary point, not the origin: a small part far from it would cancel.
+    let Some(&first) = ids.first() else { return };
+    let origin = mesh.nodes[corners(first)[0]];
+    let mut volume: HashMap<usize, f64> = HashMap::new();
+    for (i, &id) in ids.iter().enumerate() {
+        let [a, b, c] = corners(id).map(|n| sub(mesh.nodes[n], origin));
+        *volume.entry(root(&mut parent, i)).or_default() += dot(a, cross(b, c)) / 6.0;
+    }
+    for (i, &id) in ids.iter().enumerate() {
+        if volume[&root(&mut parent, i)] < 0.0 {
+            on_boundary[id] = false;
+        }
+    }
+}
+
 /// The boundary surface of `mesh` (faces used by exactly one tet, less the
-/// coincident pairs of the module doc), outward
+/// coincident pairs and the sealed cavities' walls of the module doc), outward
 /// oriented if the tets are positively oriented (run [`crate::check`] first),
 /// with local node numbering in order of first use. For 10-node meshes the
 /// mid-edge nodes of each triangle's edges (0,1), (1,2), (2,0) are included.
@@ -129,6 +181,7 @@ pub fn boundary_surface(mesh: &TetMesh) -> Surface {
         }
     }
     drop_coincident_faces(mesh, &mut on_boundary);
+    drop_cavity_walls(mesh, &mut on_boundary);
     let quadratic = matches!(mesh.cells, Cells::Tet10(_));
     let mut local = vec![usize::MAX; mesh.nodes.len()];
     let mut surface = Surface::default();

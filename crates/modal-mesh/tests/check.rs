@@ -161,6 +161,28 @@ fn box_surface_area_orientation_and_closedness() {
 }
 
 #[test]
+fn a_sealed_cavity_is_not_surface() {
+    // A unit cube of 3 × 3 × 3 cells with the middle cell's tets taken out:
+    // a hollow box. The cavity's walls face into it (negative enclosed
+    // volume); no sound leaves it, so only the outside is surface.
+    let (full, _) = check(box_mesh([1.0, 1.0, 1.0], [3, 3, 3])).unwrap();
+    let Cells::Tet4(tets) = &full.cells else { panic!("linear box") };
+    let middle = |t: &[usize; 4]| {
+        let c: Vec<f64> = (0..3).map(|k| t.iter().map(|&n| full.nodes[n][k]).sum::<f64>() / 4.0).collect();
+        c.iter().all(|&x| x > 1.0 / 3.0 && x < 2.0 / 3.0)
+    };
+    let kept: Vec<[usize; 4]> = tets.iter().filter(|t| !middle(t)).copied().collect();
+    assert!(kept.len() < tets.len(), "the middle cell has tets");
+    let hollow = TetMesh { nodes: full.nodes.clone(), cells: Cells::Tet4(kept), groups: Vec::new() };
+    let (hollow, _) = check(hollow).unwrap();
+    let s = boundary_surface(&hollow);
+    assert_eq!(s.triangles.len(), boundary_surface(&full).triangles.len());
+    assert!((s.area() - 6.0).abs() < 1e-12, "{}", s.area());
+    assert!((flux_of_position(&s) - 3.0).abs() < 1e-12, "the box's volume, cavity included");
+    assert_eq!(s.open_edge_count(), 0);
+}
+
+#[test]
 fn quadratic_surface_carries_mid_edge_nodes() {
     let (mesh, _) = check(to_quadratic(&box_mesh([1.0, 1.0, 1.0], [2, 2, 2]))).unwrap();
     let s = boundary_surface(&mesh);

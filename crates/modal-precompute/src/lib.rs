@@ -40,8 +40,9 @@ pub use pipeline::{
 /// products of the Krylov blocks on a row-major copy (`modal-eigen` `cgs`); 6 — our own
 /// two-core numeric Cholesky for factors below 40 M entries (`modal-eigen` `supernodal`); 7 —
 /// the bank's surface leaves out coincident boundary faces, an internal crack
-/// (`modal_mesh::boundary_surface`).
-pub const SOLVER_VERSION: &str = "modal-precompute-7";
+/// (`modal_mesh::boundary_surface`); 8 — a hollow surface keeps its cavity
+/// (`modal-tetra` nesting) and the bank's surface leaves out sealed cavities' walls.
+pub const SOLVER_VERSION: &str = "modal-precompute-8";
 
 /// Everything that can stop the pipeline, each naming the stage it came from.
 #[derive(Debug, thiserror::Error)]
