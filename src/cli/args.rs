@@ -150,7 +150,7 @@ pub enum MeshShape {
     Corpus(crate::cli::corpus::CorpusArgs),
     /// Tetrahedralize a surface mesh (OBJ, STL, PLY).
     Tet {
-        /// Surface mesh to fill with tets.
+        /// Surface mesh to fill with tets (.obj, .stl, .ply, .glb, .gltf).
         input: PathBuf,
         /// Output .msh file (Gmsh 4.1).
         #[arg(short, long)]
@@ -192,7 +192,7 @@ pub struct GenerateArgs {
 
 #[derive(Debug, Args)]
 pub struct ExportMatricesArgs {
-    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply).
+    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply, .glb, .gltf).
     pub mesh: PathBuf,
     /// Output directory (created).
     #[arg(long, short)]
@@ -208,7 +208,8 @@ pub struct ExportMatricesArgs {
 
 #[derive(Debug, Args)]
 pub struct PrecomputeArgs {
-    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply).
+    /// Tet mesh (.msh, .node/.ele, .mesh), surface mesh (.obj, .stl, .ply, or a .glb/.gltf
+    /// scene's meshes), or a .glb holding a modal model (read as the bank, no solve).
     pub mesh: PathBuf,
     /// Output mode bank (safetensors).
     #[arg(short, long)]

@@ -69,7 +69,11 @@ pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Option<BankCache> {
 }
 
 pub fn run(args: PrecomputeArgs) -> Result<()> {
-    if modal_export::gltf::is_gltf_path(&args.mesh) {
+    // A glTF with a modal model is a bank; one without is geometry, meshed like an OBJ.
+    if modal_export::gltf::is_gltf_path(&args.mesh)
+        && modal_export::gltf::holds_modal_model(&args.mesh)
+            .with_context(|| format!("cannot read {}", args.mesh.display()))?
+    {
         return import_gltf(&args);
     }
     let mut request = request(&args.mesh, &args.material, &args.input)?;

@@ -124,7 +124,7 @@ impl TetBudget {
 /// True for file types that hold a surface to be tetrahedralized.
 pub fn is_surface_file(path: &Path) -> bool {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    matches!(ext.as_str(), "obj" | "stl" | "ply")
+    matches!(ext.as_str(), "obj" | "stl" | "ply" | "glb" | "gltf")
 }
 
 /// Loads, (tetrahedralizes,) scales and checks a mesh.

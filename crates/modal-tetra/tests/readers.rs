@@ -170,3 +170,108 @@ fn hostile_input_gives_typed_errors() {
     let text = String::from_utf8(stl_ascii(&sphere)).unwrap().replacen("vertex ", "vertex NaN ", 1);
     assert!(parse(text.as_bytes(), SurfaceFormat::Stl).is_err());
 }
+
+/// The JSON and binary chunks of a `.glb` of one mesh (`s`, f32 positions,
+/// u32 indices) and the given scene `nodes` (JSON) and root nodes.
+fn glb_chunks(s: &TriSurface, nodes: &str, roots: &str) -> (String, Vec<u8>) {
+    let mut bin: Vec<u8> = s.vertices.iter().flatten().flat_map(|&c| (c as f32).to_le_bytes()).collect();
+    let positions = bin.len();
+    bin.extend(s.triangles.iter().flatten().flat_map(|&v| (v as u32).to_le_bytes()));
+    let fold = |pick: fn(f64, f64) -> f64, from: f64| {
+        s.vertices.iter().fold([from; 3], |acc, p| std::array::from_fn(|k| pick(acc[k], p[k])))
+    };
+    let (lo, hi) = (fold(f64::min, f64::INFINITY), fold(f64::max, f64::NEG_INFINITY));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":{roots}}}],"nodes":{nodes},
+        "meshes":[{{"name":"sphere","primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "buffers":[{{"byteLength":{}}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{positions}}},
+                       {{"buffer":0,"byteOffset":{positions},"byteLength":{}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3","min":{:?},"max":{:?}}},
+                     {{"bufferView":1,"componentType":5125,"count":{},"type":"SCALAR"}}]}}"#,
+        bin.len(),
+        bin.len() - positions,
+        s.vertices.len(),
+        lo.map(|x| x as f32),
+        hi.map(|x| x as f32),
+        3 * s.triangles.len()
+    );
+    (json, bin)
+}
+
+/// A GLB container of a JSON and a binary chunk (glTF §4.4).
+fn pack((json, bin): (String, Vec<u8>)) -> Vec<u8> {
+    let mut json = json.into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+fn glb(s: &TriSurface, nodes: &str, roots: &str) -> Vec<u8> {
+    pack(glb_chunks(s, nodes, roots))
+}
+
+#[test]
+fn a_glb_scene_places_its_meshes_in_world_coordinates() {
+    // One sphere mesh placed twice: under a shifted parent and mirrored
+    // (scale z = −1, so its winding must be reversed to face out), and alone.
+    let sphere = shapes::icosphere(0.05, 2);
+    let nodes = r#"[{"name":"parent","translation":[1,0,0],"children":[1]},
+                    {"name":"mirrored","scale":[1,1,-1],"mesh":0},
+                    {"name":"lifted","translation":[0,0.3,0],"mesh":0}]"#;
+    let bytes = glb(&sphere, nodes, "[0,2]");
+    let (s, report) = parse_surface(&bytes, SurfaceFormat::Gltf, 1.0, None).unwrap();
+    assert_eq!(report.parts, ["mirrored", "lifted"]);
+    assert_eq!(s.triangles.len(), 2 * sphere.triangles.len());
+    assert_eq!(report.flipped_faces, 0, "both copies face out as read");
+    let one = modal_tetra::diagnose(&sphere).enclosed_volume_m3;
+    assert!((report.enclosed_volume_m3 / (2.0 * one) - 1.0).abs() < 1e-5, "{report:?}");
+    let (lo, hi) = s.bounding_box().unwrap();
+    assert!((lo[0] + 0.05).abs() < 1e-6 && (hi[0] - 1.05).abs() < 1e-6, "{lo:?} {hi:?}");
+    assert!((hi[1] - 0.35).abs() < 1e-6, "{hi:?}");
+    // A file of the format, with parts picked like an OBJ's.
+    let path = tempfile::Builder::new().suffix(".glb").tempfile().unwrap();
+    std::fs::write(path.path(), &bytes).unwrap();
+    let (picked, _) = read_surface(path.path(), 1.0, Some("lifted")).unwrap();
+    assert_eq!(picked.triangles.len(), sphere.triangles.len());
+}
+
+#[test]
+fn hostile_glb_gives_typed_errors() {
+    let sphere = shapes::icosphere(0.05, 1);
+    let placed = r#"[{"mesh":0}]"#;
+    let good = glb(&sphere, placed, "[0]");
+    let parse_err = |bytes: &[u8]| match parse(bytes, SurfaceFormat::Gltf) {
+        Err(TetraError::Parse { format: "glTF", message }) => message,
+        other => panic!("expected a glTF parse error, got {other:?}"),
+    };
+    // Truncated, garbage, no mesh placed, an index beyond the positions,
+    // positions compressed away (no buffer view), a cyclic hierarchy.
+    parse_err(&good[..good.len() / 2]);
+    parse_err(b"glTF\x02\0\0\0garbage");
+    assert!(parse_err(&glb(&sphere, r#"[{"name":"empty"}]"#, "[0]")).contains("no triangles"));
+    let mut wild = sphere.clone();
+    wild.triangles[0][0] = sphere.vertices.len();
+    parse_err(&glb(&wild, placed, "[0]"));
+    let (json, bin) = glb_chunks(&sphere, placed, "[0]");
+    let draco = json.replacen(r#""bufferView":0,"#, "", 1).replacen(
+        r#""scene":0"#,
+        r#""extensionsUsed":["KHR_draco_mesh_compression"],"scene":0"#,
+        1,
+    );
+    let compressed = pack((draco, bin));
+    let message = parse_err(&compressed);
+    assert!(message.contains("decompress"), "{message}");
+    parse_err(&glb(&sphere, r#"[{"mesh":0,"children":[1]},{"children":[0]}]"#, "[0]"));
+}

@@ -22,7 +22,7 @@
 mod read;
 mod write;
 
-pub use read::{import_glb, import_gltf_file, is_gltf_path, Imported};
+pub use read::{holds_modal_model, import_glb, import_gltf_file, is_gltf_path, Imported};
 pub use write::export_glb;
 
 /// Name of the extension written (and read).

@@ -43,6 +43,16 @@ pub fn is_gltf_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
 }
 
+/// Whether the glTF file at `path` carries a modal model (the
+/// `KHR_audio_rigid_bodies` root extension, or its legacy name): then it is
+/// a bank; without one it is only geometry, to be meshed and solved.
+pub fn holds_modal_model(path: &Path) -> Result<bool, ExportError> {
+    let bytes =
+        std::fs::read(path).map_err(|source| ExportError::Read { path: path.to_path_buf(), source })?;
+    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| ExportError::Gltf(e.to_string()))?;
+    Ok(gltf.extension_value(EXTENSION).is_some() || gltf.extension_value(LEGACY_EXTENSION).is_some())
+}
+
 /// Reads the modal model of a `.glb`, or of a `.gltf` whose buffers are
 /// files next to it.
 pub fn import_gltf_file(path: &Path) -> Result<Imported, ExportError> {

@@ -1,11 +1,13 @@
-//! Surface readers: Wavefront OBJ (tobj), STL ASCII/binary (stl_io) and PLY
-//! ASCII/binary (ply-rs-bw), all into a [`TriSurface`] in metres.
+//! Surface readers: Wavefront OBJ (tobj), STL ASCII/binary (stl_io), PLY
+//! ASCII/binary (ply-rs-bw) and glTF 2.0 (gltf: the meshes a scene
+//! places), all into a [`TriSurface`] in metres.
 //!
 //! Coordinates are taken as metres and never rescaled silently; `scale`
 //! multiplies them. Third-party parsers run under `catch_unwind` as a last
 //! resort so that a parser bug on hostile bytes becomes a
 //! [`TetraError::Parse`] instead of a panic in the caller.
 
+mod gltf_file;
 mod obj;
 mod ply;
 mod stl;
@@ -23,6 +25,9 @@ pub enum SurfaceFormat {
     Stl,
     /// Stanford PLY, ASCII or binary (`vertex` x/y/z, `face` vertex_indices).
     Ply,
+    /// glTF 2.0, `.glb` or `.gltf` (the triangles of every mesh the default
+    /// scene places, in world coordinates; each placed mesh is a part).
+    Gltf,
 }
 
 impl SurfaceFormat {
@@ -33,6 +38,7 @@ impl SurfaceFormat {
             "obj" => Some(Self::Obj),
             "stl" => Some(Self::Stl),
             "ply" => Some(Self::Ply),
+            "glb" | "gltf" => Some(Self::Gltf),
             _ => None,
         }
     }
@@ -52,15 +58,27 @@ pub fn read_surface(
     let format = SurfaceFormat::from_path(path)
         .ok_or_else(|| TetraError::UnsupportedFormat { path: path.to_path_buf() })?;
     let bytes = std::fs::read(path).map_err(|source| TetraError::Io { path: path.to_path_buf(), source })?;
-    parse_surface(&bytes, format, scale, part)
+    parse_surface_beside(&bytes, format, scale, part, path.parent())
 }
 
-/// Like [`read_surface`] but from bytes already in memory.
+/// Like [`read_surface`] but from bytes already in memory (a `.gltf` whose
+/// buffers are files cannot be read this way: give the path, or a `.glb`).
 pub fn parse_surface(
     bytes: &[u8],
     format: SurfaceFormat,
     scale: f64,
     part: Option<&str>,
+) -> Result<(TriSurface, SurfaceReport), TetraError> {
+    parse_surface_beside(bytes, format, scale, part, None)
+}
+
+/// [`parse_surface`] with a `.gltf`'s buffer files looked up in `folder`.
+fn parse_surface_beside(
+    bytes: &[u8],
+    format: SurfaceFormat,
+    scale: f64,
+    part: Option<&str>,
+    folder: Option<&Path>,
 ) -> Result<(TriSurface, SurfaceReport), TetraError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(TetraError::InvalidOption {
@@ -72,6 +90,7 @@ pub fn parse_surface(
         SurfaceFormat::Obj => obj::parse(bytes),
         SurfaceFormat::Stl => stl::parse(bytes),
         SurfaceFormat::Ply => ply::parse(bytes),
+        SurfaceFormat::Gltf => gltf_file::parse(bytes, folder),
     })?;
     surface.validate()?;
     if let Some(name) = part {
@@ -88,6 +107,7 @@ fn format_name(format: SurfaceFormat) -> &'static str {
         SurfaceFormat::Obj => "OBJ",
         SurfaceFormat::Stl => "STL",
         SurfaceFormat::Ply => "PLY",
+        SurfaceFormat::Gltf => "glTF",
     }
 }
 

@@ -1,0 +1,245 @@
+//! glTF 2.0 (`.glb`, or `.gltf` with its buffers in files next to it)
+//! through the `gltf` crate: the triangles of every mesh the default scene
+//! (else the first, else every root node) places, in world coordinates.
+//!
+//! A node's world matrix is its parents' times its own (`T·R·S` or the
+//! given matrix, glTF §5.25); positions are `M·[x y z 1]ᵀ` in metres, the
+//! format's unit. A mirroring matrix (`det M < 0`) reverses the triangles'
+//! winding, so they still face out. Triangle strips and fans are split into
+//! triangles; points and lines are skipped. Each placed mesh becomes a part
+//! named after its node (else its mesh, else `mesh N`).
+//!
+//! Refused with a clear error rather than read wrongly: compressed or
+//! quantized positions (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`,
+//! `KHR_mesh_quantization`: decompress first), `data:` URI buffers, buffers
+//! shorter than declared, indices out of range, node hierarchies deeper
+//! than [`MAX_DEPTH`] (or cyclic).
+
+use std::path::Path;
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::mesh::Mode;
+
+use crate::{TetraError, TriSurface};
+
+/// Deepest node hierarchy followed (a cycle would be endless).
+pub const MAX_DEPTH: usize = 64;
+
+fn bad(message: impl Into<String>) -> TetraError {
+    TetraError::Parse { format: "glTF", message: message.into() }
+}
+
+type Matrix = [[f64; 4]; 4];
+
+/// Parses glTF bytes; `base` is the folder of a `.gltf` whose buffers are files.
+pub(super) fn parse(bytes: &[u8], base: Option<&Path>) -> Result<TriSurface, TetraError> {
+    let doc = gltf::Gltf::from_slice(bytes).map_err(|e| bad(with_compression_hint(bytes, e.to_string())))?;
+    let buffers = buffers(&doc, base)?;
+    let mut surface = TriSurface::default();
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            let children: std::collections::HashSet<usize> =
+                doc.nodes().flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>()).collect();
+            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    let identity: Matrix = std::array::from_fn(|i| std::array::from_fn(|j| f64::from(u8::from(i == j))));
+    for node in roots {
+        place(&node, &identity, 0, &buffers, &mut surface)?;
+    }
+    if surface.triangles.is_empty() {
+        return Err(bad("the scene places no triangles (only points or lines, or no meshes)"));
+    }
+    Ok(surface)
+}
+
+/// Compressed or quantized positions: extensions the `gltf` crate does not decode.
+const UNDECODED: [&str; 3] =
+    ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_mesh_quantization"];
+
+/// `message`, and which undecoded extension the file names, if any (a Draco
+/// file's accessors have no data of their own, which the crate reports as
+/// missing data).
+fn with_compression_hint(bytes: &[u8], message: String) -> String {
+    match UNDECODED.iter().find(|ext| bytes.windows(ext.len()).any(|w| w == ext.as_bytes())) {
+        Some(ext) => {
+            format!("{message} (the file uses {ext}: decompress it first, e.g. with gltf-transform)")
+        }
+        None => message,
+    }
+}
+
+/// Every buffer's bytes: the GLB's binary chunk or a file next to a `.gltf`.
+fn buffers(doc: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, TetraError> {
+    doc.buffers()
+        .map(|buffer| {
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => doc
+                    .blob
+                    .clone()
+                    .ok_or_else(|| bad("buffer 0 is the GLB's binary chunk, but there is none"))?,
+                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                    return Err(bad("data: URI buffers are not read (convert the file to .glb)"))
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    let base = base.ok_or_else(|| bad(format!("buffer '{uri}' is an external file")))?;
+                    let path = base.join(uri);
+                    std::fs::read(&path).map_err(|source| TetraError::Io { path, source })?
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(bad(format!(
+                    "buffer {} holds {} bytes, {} declared",
+                    buffer.index(),
+                    data.len(),
+                    buffer.length()
+                )));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+/// Adds the triangles of `node` and its children under the parent matrix `parent`.
+fn place(
+    node: &gltf::Node,
+    parent: &Matrix,
+    depth: usize,
+    buffers: &[Vec<u8>],
+    surface: &mut TriSurface,
+) -> Result<(), TetraError> {
+    if depth >= MAX_DEPTH {
+        return Err(bad(format!("the node hierarchy is deeper than {MAX_DEPTH} (or cyclic)")));
+    }
+    let local = node.transform().matrix().map(|column| column.map(f64::from));
+    let world = multiply(parent, &local);
+    if let Some(mesh) = node.mesh() {
+        let name =
+            node.name().or(mesh.name()).map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+        let first = surface.triangles.len();
+        for primitive in mesh.primitives() {
+            add_primitive(&primitive, &world, buffers, surface)?;
+        }
+        if surface.triangles.len() > first {
+            surface.parts.push((name, first..surface.triangles.len()));
+        }
+    }
+    for child in node.children() {
+        place(&child, &world, depth + 1, buffers, surface)?;
+    }
+    Ok(())
+}
+
+/// Adds one primitive's triangles, positions mapped by `world`.
+fn add_primitive(
+    primitive: &gltf::Primitive,
+    world: &Matrix,
+    buffers: &[Vec<u8>],
+    surface: &mut TriSurface,
+) -> Result<(), TetraError> {
+    if matches!(primitive.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
+        return Ok(());
+    }
+    let positions = primitive
+        .get(&gltf::Semantic::Positions)
+        .ok_or_else(|| bad("a triangle primitive has no POSITION attribute"))?;
+    if positions.view().is_none()
+        || positions.data_type() != DataType::F32
+        || positions.dimensions() != Dimensions::Vec3
+    {
+        return Err(bad(
+            "positions that are not plain 32-bit floats (compressed or quantized: KHR_draco_mesh_compression, \
+             EXT_meshopt_compression or KHR_mesh_quantization; decompress the file first)",
+        ));
+    }
+    if primitive
+        .indices()
+        .is_some_and(|i| !matches!(i.data_type(), DataType::U8 | DataType::U16 | DataType::U32))
+    {
+        return Err(bad("indices that are not unsigned integers"));
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let read = reader.read_positions().ok_or_else(|| bad("positions reach past their buffer"))?;
+    let offset = surface.vertices.len();
+    surface.vertices.extend(read.map(|p| transform(world, p.map(f64::from))));
+    let count = surface.vertices.len() - offset;
+    let indices: Vec<usize> = match primitive.indices() {
+        Some(_) => {
+            let read = reader.read_indices().ok_or_else(|| bad("indices reach past their buffer"))?;
+            read.into_u32().map(|i| i as usize).collect()
+        }
+        None => (0..count).collect(),
+    };
+    if let Some(&i) = indices.iter().find(|&&i| i >= count) {
+        return Err(bad(format!("index {i} beyond the primitive's {count} positions")));
+    }
+    let mirrored = determinant3(world) < 0.0;
+    for t in triangles(primitive.mode(), &indices) {
+        let [a, b, c] = t.map(|i| offset + i);
+        surface.triangles.push(if mirrored { [a, c, b] } else { [a, b, c] });
+    }
+    Ok(())
+}
+
+/// The triangles (counter-clockwise) of a triangle list, strip or fan.
+fn triangles(mode: Mode, indices: &[usize]) -> Vec<[usize; 3]> {
+    match mode {
+        Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                let (a, b, c) = (indices[k - 2], indices[k - 1], indices[k]);
+                if k % 2 == 0 {
+                    [a, b, c]
+                } else {
+                    [b, a, c]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect(),
+        _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    }
+}
+
+/// `a · b` of column-major 4 × 4 matrices (`m[column][row]`, as glTF stores them).
+fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
+    std::array::from_fn(|col| std::array::from_fn(|row| (0..4).map(|k| a[k][row] * b[col][k]).sum()))
+}
+
+/// `M·[p 1]ᵀ` (affine part) of a column-major matrix.
+fn transform(m: &Matrix, p: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|row| m[0][row] * p[0] + m[1][row] * p[1] + m[2][row] * p[2] + m[3][row])
+}
+
+/// Determinant of the upper-left 3 × 3 block (the linear part).
+fn determinant3(m: &Matrix) -> f64 {
+    let c = |col: usize, row: usize| m[col][row];
+    c(0, 0) * (c(1, 1) * c(2, 2) - c(2, 1) * c(1, 2)) - c(1, 0) * (c(0, 1) * c(2, 2) - c(2, 1) * c(0, 2))
+        + c(2, 0) * (c(0, 1) * c(1, 2) - c(1, 1) * c(0, 2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_become_counter_clockwise_triangles() {
+        assert_eq!(triangles(Mode::TriangleStrip, &[0, 1, 2, 3]), vec![[0, 1, 2], [2, 1, 3]]);
+        assert_eq!(triangles(Mode::TriangleFan, &[0, 1, 2, 3]), vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]), vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn matrices_compose_parent_first_and_mirroring_is_seen() {
+        let mut shift: Matrix = std::array::from_fn(|i| std::array::from_fn(|j| f64::from(u8::from(i == j))));
+        shift[3] = [1.0, 2.0, 3.0, 1.0];
+        let mut double = shift;
+        double[3] = [0.0, 0.0, 0.0, 1.0];
+        double[0][0] = 2.0;
+        double[1][1] = 2.0;
+        double[2][2] = -2.0;
+        // Parent shifts, child scales: the point is scaled, then shifted.
+        let world = multiply(&shift, &double);
+        assert_eq!(transform(&world, [1.0, 1.0, 1.0]), [3.0, 4.0, 1.0]);
+        assert!(determinant3(&world) < 0.0 && determinant3(&shift) > 0.0);
+    }
+}
