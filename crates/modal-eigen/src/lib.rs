@@ -36,5 +36,5 @@ mod types;
 
 pub use factor::Analysis;
 pub use krylov::{attainable as residual_bound, STALL_RESTARTS};
-pub use solve::{analyze, default_memory_limit, solve, solve_analyzed};
+pub use solve::{analyze, default_memory_limit, solve, solve_analyzed, vector_bytes_per_dof};
 pub use types::*;

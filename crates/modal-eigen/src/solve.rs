@@ -380,6 +380,16 @@ fn stall_hint(e: EigenError, below: Option<usize>, min_freq_hz: f64) -> EigenErr
     EigenError::Stalled { converged, wanted, restarts, hint }
 }
 
+/// Bytes per DOF of the dense vectors a solve for `opts` holds at its peak (the basis, work
+/// blocks and Ritz vectors of [`vector_bytes`]; part of `memory_estimate_bytes`), known
+/// before any matrix exists: at a million DOF and 64 modes they take ≈ 9 GB, more than
+/// most factors.
+pub fn vector_bytes_per_dof(opts: &EigenOptions) -> u64 {
+    let block = opts.block_size.max(1);
+    let nev = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
+    vector_bytes(1, nev, basis_size(nev, block), block)
+}
+
 /// Krylov basis size (columns, excluding the residual block) for `nev` wanted pairs:
 /// `nev + max(nev, min(2·nev, EXTRA_BASIS), 3·block)`. A basis of about 3·nev for up to 50
 /// modes measured 12 % fewer block solves than ARPACK's customary 2·nev (box, 30k DOF,

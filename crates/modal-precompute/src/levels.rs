@@ -91,7 +91,7 @@ impl Default for AccuracyTarget {
 
 /// At most this many coarser first levels are tried when the default one does not fit
 /// the memory guard ([`within_memory`]).
-pub const MEMORY_RETRIES: usize = 3;
+pub const MEMORY_RETRIES: usize = 5;
 
 /// Margin on the memory overrun when the first level is coarsened to fit.
 const MEMORY_MARGIN: f64 = 1.25;

@@ -81,8 +81,9 @@ impl LevelSize {
 ///
 /// The solve holds K and M, at least
 /// [`modal_fem::min_quadratic_matrices_bytes`] (270 stored entries a tet, whatever
-/// the mesh), and the factor of `K − σM`, at least the lower triangle of that
-/// pattern (135 values of 8 bytes a tet): both lower bounds, so a mesh refused here
+/// the mesh), the factor of `K − σM`, at least the lower triangle of that
+/// pattern (135 values of 8 bytes a tet), and the eigensolver's dense vectors for
+/// at least 3 DOF a tet: all lower bounds, so a mesh refused here
 /// could not have been solved within the limit, and it is refused in a second
 /// instead of after minutes of meshing and assembly (a thin bowl at a 1.2 mm cell:
 /// 1.6 M tets in 23 s, then refused for the matrices' 23 GB).
@@ -90,6 +91,9 @@ impl LevelSize {
 pub(crate) struct TetBudget {
     /// The memory guard [bytes].
     pub limit_bytes: u64,
+    /// The eigensolver's dense vectors per DOF [bytes] ([`modal_eigen::vector_bytes_per_dof`]);
+    /// a 10-node tet mesh has at least 3 DOF per tet (a node per edge, and E ≥ T).
+    pub vector_bytes_per_dof: u64,
 }
 
 impl TetBudget {
@@ -97,21 +101,23 @@ impl TetBudget {
     const FACTOR_BYTES_PER_TET: u64 = 9 * modal_fem::MIN_NODE_PAIRS_PER_QUADRATIC_TET * 8;
 
     /// The fewest bytes a solve of `tets` 10-node tets holds.
-    fn min_bytes(tets: u64) -> u64 {
-        modal_fem::min_quadratic_matrices_bytes(tets) + Self::FACTOR_BYTES_PER_TET * tets
+    fn min_bytes(&self, tets: u64) -> u64 {
+        modal_fem::min_quadratic_matrices_bytes(tets)
+            + Self::FACTOR_BYTES_PER_TET * tets
+            + 3 * self.vector_bytes_per_dof * tets
     }
 
     /// The most tets whose solve can fit.
     pub(crate) fn max_tets(&self) -> usize {
-        usize::try_from(self.limit_bytes / Self::min_bytes(1).max(1)).unwrap_or(usize::MAX)
+        usize::try_from(self.limit_bytes / self.min_bytes(1).max(1)).unwrap_or(usize::MAX)
     }
 
     fn refusal(&self, estimated: u64) -> PrecomputeError {
-        let needed_bytes = Self::min_bytes(estimated);
+        let needed_bytes = self.min_bytes(estimated);
         PrecomputeError::Memory {
             message: format!(
-                "the surface would be meshed into about {estimated} tets, whose stiffness, mass and factor need at \
-                 least {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
+                "the surface would be meshed into about {estimated} tets, whose stiffness, mass, factor and the \
+                 eigensolver's vectors need at least {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
                 needed_bytes as f64 / 1e9,
                 self.limit_bytes as f64 / 1e9
             ),

@@ -182,7 +182,10 @@ pub(crate) fn assemble_and_analyze(
     request.validate()?;
     progress(Stage::Load);
     let limit = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
-    let budget = limit.filter(|_| request.order == 2).map(|limit_bytes| TetBudget { limit_bytes });
+    let vector_bytes_per_dof = modal_eigen::vector_bytes_per_dof(&eigen_options(request));
+    let budget = limit
+        .filter(|_| request.order == 2)
+        .map(|limit_bytes| TetBudget { limit_bytes, vector_bytes_per_dof });
     let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level, budget)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
@@ -202,7 +205,14 @@ pub(crate) fn assemble_and_analyze(
             // (4.5 M DOF: 15 GB of K and M assembled, then a 110 GB factor refused).
             let analysis = analyze_pattern();
             if let (Some(a), Some(limit)) = (&analysis, limit) {
-                refuse_beyond_memory(pattern.dof_count(), matrices_bytes, a.factor_value_bytes(), limit)?;
+                let vectors = vector_bytes_per_dof * pattern.dof_count() as u64;
+                refuse_beyond_memory(
+                    pattern.dof_count(),
+                    matrices_bytes,
+                    a.factor_value_bytes(),
+                    vectors,
+                    limit,
+                )?;
             }
             (pattern.assemble(&mesh, &request.material)?, analysis)
         } else if analyze && request.fix_box.is_none() {
@@ -226,26 +236,43 @@ pub(crate) fn assemble_and_analyze(
     Ok((assembled, analysis))
 }
 
-/// Refuses a solve whose K and M (`matrices_bytes`) and factor values
-/// (`factor_bytes`), both held during the solve, exceed `limit` [bytes].
+/// The eigensolver's options for `request`.
+fn eigen_options(request: &Request) -> EigenOptions {
+    EigenOptions {
+        min_freq_hz: request.min_freq_hz,
+        max_freq_hz: request.max_freq_hz,
+        max_modes: request.max_modes,
+        threads: request.threads.unwrap_or(0),
+        memory_limit_bytes: request.memory_limit_bytes,
+        ..EigenOptions::default()
+    }
+}
+
+/// Refuses a solve whose K and M (`matrices_bytes`), factor values (`factor_bytes`) and
+/// the eigensolver's dense vectors (`vector_bytes`), all held during the solve, exceed
+/// `limit` [bytes].
 fn refuse_beyond_memory(
     dofs: usize,
     matrices_bytes: u64,
     factor_bytes: u64,
+    vector_bytes: u64,
     limit: u64,
 ) -> Result<(), PrecomputeError> {
-    if matrices_bytes + factor_bytes <= limit {
+    let needed_bytes = matrices_bytes + factor_bytes + vector_bytes;
+    if needed_bytes <= limit {
         return Ok(());
     }
     Err(PrecomputeError::Memory {
         message: format!(
             "the mesh has {dofs} DOF: its stiffness and mass matrices need ≈ {:.1} GB and their factor ≈ {:.1} GB, \
-             above the memory limit of {:.1} GB; use a coarser mesh (a larger element size or --cell) or --order 1",
+             the eigensolver's vectors ≈ {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a \
+             larger element size or --cell) or --order 1",
             matrices_bytes as f64 / 1e9,
             factor_bytes as f64 / 1e9,
+            vector_bytes as f64 / 1e9,
             limit as f64 / 1e9
         ),
-        needed_bytes: matrices_bytes + factor_bytes,
+        needed_bytes,
         limit_bytes: limit,
     })
 }
@@ -385,14 +412,7 @@ pub(crate) fn solve_bank(
         None => (&assembled.k, &assembled.m, modal_fem::DofMap::from_clamped(&clamped)),
     };
     let rigid = restrict_rows(&rigid_full, &dof_map.free_to_full);
-    let options = EigenOptions {
-        min_freq_hz: request.min_freq_hz,
-        max_freq_hz: request.max_freq_hz,
-        max_modes: request.max_modes,
-        threads: request.threads.unwrap_or(0),
-        memory_limit_bytes: request.memory_limit_bytes,
-        ..EigenOptions::default()
-    };
+    let options = eigen_options(request);
     let rigid_ref = (rigid.ncols() > 0).then(|| rigid.as_ref());
     let solution = modal_eigen::solve_analyzed(k, m, rigid_ref, &options, analysis, &mut |p| {
         progress(Stage::Solve(format!("{p:?}")))
