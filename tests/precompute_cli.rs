@@ -316,43 +316,20 @@ fn a_mesh_whose_factor_exceeds_the_memory_guard_is_refused_before_its_matrices_a
 /// A geometry-only `.glb` (no modal model): the unit cube's 12 triangles,
 /// placed by one node scaled by `scale` (glTF §5.25: T·R·S).
 fn unit_cube_glb(scale: [f64; 3]) -> Vec<u8> {
-    let corners: Vec<[f32; 3]> =
-        (0..8).map(|i| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32]).collect();
-    let faces: [[u32; 3]; 12] = [
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
-    let mut bin: Vec<u8> = corners.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
-    bin.extend(faces.iter().flatten().flat_map(|i| i.to_le_bytes()));
-    let json = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"scale":{scale:?}}}],
-        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"buffers":[{{"byteLength":240}}],
-        "bufferViews":[{{"buffer":0,"byteLength":96}},{{"buffer":0,"byteOffset":96,"byteLength":144}}],
-        "accessors":[{{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}},
-        {{"bufferView":1,"componentType":5125,"count":36,"type":"SCALAR"}}]}}"#
-    );
-    let mut json = json.into_bytes();
-    json.resize(json.len().div_ceil(4) * 4, b' ');
-    let mut glb = b"glTF".to_vec();
-    glb.extend(2u32.to_le_bytes());
-    glb.extend(((28 + json.len() + bin.len()) as u32).to_le_bytes());
-    glb.extend((json.len() as u32).to_le_bytes());
-    glb.extend(b"JSON");
-    glb.extend(json);
-    glb.extend((bin.len() as u32).to_le_bytes());
-    glb.extend(b"BIN\0");
-    glb.extend(bin);
-    glb
+    let cube = modal_tetra::shapes::cuboid(1.0, 1.0, 1.0);
+    let mut bin: Vec<u8> = cube.vertices.iter().flatten().flat_map(|&c| (c as f32).to_le_bytes()).collect();
+    bin.extend(cube.triangles.iter().flatten().flat_map(|&i| (i as u32).to_le_bytes()));
+    let document = serde_json::json!({
+        "asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "scale": scale}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 144}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+            {"bufferView": 1, "componentType": 5125, "count": 36, "type": "SCALAR"}
+        ]
+    });
+    modal_export::gltf::glb_container(&document, bin).unwrap()
 }
 
 #[test]
@@ -363,11 +340,8 @@ fn a_glb_without_a_modal_model_is_meshed_like_the_same_obj() {
     // Binary fractions: the glTF's f32 scale and the OBJ's decimals are the same numbers.
     let size = [0.125, 0.0625, 0.03125];
     std::fs::write(dir.path().join("box.glb"), unit_cube_glb(size)).unwrap();
-    let obj = (0..8)
-        .map(|i| format!("v {} {} {}\n", size[0] * (i & 1) as f64, size[1] * (i >> 1 & 1) as f64, size[2] * (i >> 2 & 1) as f64))
-        .collect::<String>()
-        + "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
-    std::fs::write(dir.path().join("box.obj"), obj).unwrap();
+    let obj = std::fs::File::create(dir.path().join("box.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(size[0], size[1], size[2]), obj).unwrap();
     let solve = |input: &str| {
         let args = ["precompute", input, "-o", "b.bank", "--no-cache", "--material", "steel", "--modes", "6"];
         modal(dir.path(), &[&args[..], &["--cell", "0.01", "--accuracy", "off", "--json"]].concat())

@@ -78,21 +78,7 @@ fn split_glb(bytes: &[u8]) -> (Value, Vec<u8>) {
 
 /// GLB bytes of a JSON document and a binary chunk.
 fn join_glb(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = json.to_string().into_bytes();
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((text.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(text);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
+    modal_export::gltf::glb_container(json, bin.to_vec()).unwrap()
 }
 
 #[test]

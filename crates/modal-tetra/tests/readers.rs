@@ -199,23 +199,10 @@ fn glb_chunks(s: &TriSurface, nodes: &str, roots: &str) -> (String, Vec<u8>) {
     (json, bin)
 }
 
-/// A GLB container of a JSON and a binary chunk (glTF §4.4).
+/// The GLB container of the chunks of [`glb_chunks`].
 fn pack((json, bin): (String, Vec<u8>)) -> Vec<u8> {
-    let mut json = json.into_bytes();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
+    let document: serde_json::Value = serde_json::from_str(&json).unwrap();
+    modal_export::gltf::glb_container(&document, bin).unwrap()
 }
 
 fn glb(s: &TriSurface, nodes: &str, roots: &str) -> Vec<u8> {

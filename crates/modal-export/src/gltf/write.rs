@@ -171,7 +171,7 @@ pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, 
         "bufferViews": layout.views,
         "buffers": [{ "byteLength": layout.bin.len() }],
     });
-    glb(&document, layout.bin)
+    glb_container(&document, layout.bin)
 }
 
 /// The `extras.modal` object: exact copies of what the accessors round.
@@ -204,8 +204,9 @@ fn exact_side_data(bank: &ModeBank, layout: &mut Layout) -> Value {
     })
 }
 
-/// Packs a document and its binary buffer into GLB bytes.
-fn glb(document: &Value, mut bin: Vec<u8>) -> Result<Vec<u8>, ExportError> {
+/// Packs a document and its binary buffer into GLB bytes (glTF §4.4: header, JSON
+/// chunk padded with spaces, BIN chunk padded with zeros).
+pub fn glb_container(document: &Value, mut bin: Vec<u8>) -> Result<Vec<u8>, ExportError> {
     let mut json = document.to_string().into_bytes();
     while !json.len().is_multiple_of(4) {
         json.push(b' ');
