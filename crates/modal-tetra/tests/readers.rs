@@ -235,6 +235,51 @@ fn a_glb_scene_places_its_meshes_in_world_coordinates() {
 }
 
 #[test]
+fn a_quantized_glb_reads_like_the_float_one() {
+    // gltfpack's default output: positions as normalized 16-bit integers
+    // (KHR_mesh_quantization), scaled back by the node; and a required
+    // texture extension that has nothing to do with the geometry.
+    let sphere = shapes::icosphere(0.05, 2);
+    let mut bin: Vec<u8> = Vec::new();
+    for p in &sphere.vertices {
+        for c in p {
+            bin.extend(((c / 0.05 * 32767.0).round() as i16).to_le_bytes());
+        }
+        bin.extend([0, 0]); // each element padded to 4 bytes: stride 8
+    }
+    let positions = bin.len();
+    bin.extend(sphere.triangles.iter().flatten().flat_map(|&v| (v as u32).to_le_bytes()));
+    let document = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_basisu"],
+        "extensionsRequired": ["KHR_mesh_quantization", "KHR_texture_basisu"],
+        "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "scale": [0.05, 0.05, 0.05]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteLength": positions, "byteStride": 8},
+                        {"buffer": 0, "byteOffset": positions, "byteLength": bin.len() - positions}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5122, "normalized": true, "count": sphere.vertices.len(),
+             "type": "VEC3", "min": [-32767, -32767, -32767], "max": [32767, 32767, 32767]},
+            {"bufferView": 1, "componentType": 5125, "count": 3 * sphere.triangles.len(), "type": "SCALAR"}
+        ]
+    });
+    let bytes = modal_export::gltf::glb_container(&document, bin).unwrap();
+    let (s, report) = parse_surface(&bytes, SurfaceFormat::Gltf, 1.0, None).unwrap();
+    assert_eq!(s.triangles.len(), sphere.triangles.len());
+    let volume = modal_tetra::diagnose(&sphere).enclosed_volume_m3;
+    // 16-bit steps of 1.5 µm on 5 cm.
+    assert!((report.enclosed_volume_m3 / volume - 1.0).abs() < 1e-4, "{report:?}");
+    let worst = s
+        .vertices
+        .iter()
+        .zip(&sphere.vertices)
+        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-6, "{worst} m");
+}
+
+#[test]
 fn hostile_glb_gives_typed_errors() {
     let sphere = shapes::icosphere(0.05, 1);
     let placed = r#"[{"mesh":0}]"#;

@@ -9,11 +9,15 @@
 //! triangles; points and lines are skipped. Each placed mesh becomes a part
 //! named after its node (else its mesh, else `mesh N`).
 //!
-//! Refused with a clear error rather than read wrongly: compressed or
-//! quantized positions (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`,
-//! `KHR_mesh_quantization`: decompress first), `data:` URI buffers, buffers
-//! shorter than declared, indices out of range, node hierarchies deeper
-//! than [`MAX_DEPTH`] (or cyclic).
+//! Quantized positions (`KHR_mesh_quantization`, what `gltfpack` writes by
+//! default: 8- or 16-bit integers, normalized or not, scaled back by the
+//! node's matrix) are read as the extension says; extensions a file
+//! requires for what is not geometry (textures, materials) do not stop it.
+//! Refused with a clear error rather than read wrongly: compressed
+//! geometry (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`:
+//! decompress first), `data:` URI buffers, buffers shorter than declared,
+//! indices out of range, node hierarchies deeper than [`MAX_DEPTH`] (or
+//! cyclic), and every other error of the document's validation.
 
 use std::path::Path;
 
@@ -33,8 +37,9 @@ type Matrix = [[f64; 4]; 4];
 
 /// Parses glTF bytes; `base` is the folder of a `.gltf` whose buffers are files.
 pub(super) fn parse(bytes: &[u8], base: Option<&Path>) -> Result<TriSurface, TetraError> {
-    let doc = gltf::Gltf::from_slice(bytes).map_err(|e| bad(with_compression_hint(bytes, e.to_string())))?;
-    let buffers = buffers(&doc, base)?;
+    let doc = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| bad(e.to_string()))?;
+    validate(&doc).map_err(|e| bad(with_compression_hint(bytes, e)))?;
+    let buffers = buffers(&doc, base, bytes)?;
     let mut surface = TriSurface::default();
     let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -54,9 +59,27 @@ pub(super) fn parse(bytes: &[u8], base: Option<&Path>) -> Result<TriSurface, Tet
     Ok(surface)
 }
 
-/// Compressed or quantized positions: extensions the `gltf` crate does not decode.
-const UNDECODED: [&str; 3] =
-    ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_mesh_quantization"];
+/// Compressed geometry: extensions the `gltf` crate does not decode.
+const UNDECODED: [&str; 2] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
+
+/// The document's validation (indices in range, required fields), less its
+/// refusal of required extensions it does not know: a file that needs
+/// `KHR_texture_basisu` for its textures or `KHR_mesh_quantization` (read
+/// here) has geometry all the same. The first error, as the crate says it.
+fn validate(doc: &gltf::Gltf) -> Result<(), String> {
+    use ::gltf::json::validation::{Error, Validate};
+    let root = doc.as_json();
+    let mut first = None;
+    root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        let unknown_extension =
+            path.as_str().starts_with("extensionsRequired") && error == Error::Unsupported;
+        if first.is_none() && !unknown_extension {
+            first = Some(format!("invalid glTF: {}: {error}", path.as_str()));
+        }
+    });
+    first.map_or(Ok(()), Err)
+}
 
 /// `message`, and which undecoded extension the file names, if any (a Draco
 /// file's accessors have no data of their own, which the crate reports as
@@ -70,11 +93,18 @@ fn with_compression_hint(bytes: &[u8], message: String) -> String {
     }
 }
 
-/// Every buffer's bytes: the GLB's binary chunk or a file next to a `.gltf`.
-fn buffers(doc: &gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, TetraError> {
+/// Every buffer's bytes: the GLB's binary chunk or a file next to a `.gltf`
+/// (`bytes`: the whole file, for the error's hint).
+fn buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Result<Vec<Vec<u8>>, TetraError> {
     doc.buffers()
         .map(|buffer| {
             let data = match buffer.source() {
+                // A compressed file's fallback buffer has no data and no URI either.
+                gltf::buffer::Source::Bin if buffer.index() > 0 => {
+                    let message =
+                        format!("buffer {} has no data (only buffer 0 is the GLB's chunk)", buffer.index());
+                    return Err(bad(with_compression_hint(bytes, message)));
+                }
                 gltf::buffer::Source::Bin => doc
                     .blob
                     .clone()
@@ -144,13 +174,10 @@ fn add_primitive(
     let positions = primitive
         .get(&gltf::Semantic::Positions)
         .ok_or_else(|| bad("a triangle primitive has no POSITION attribute"))?;
-    if positions.view().is_none()
-        || positions.data_type() != DataType::F32
-        || positions.dimensions() != Dimensions::Vec3
-    {
+    if positions.view().is_none() || positions.dimensions() != Dimensions::Vec3 {
         return Err(bad(
-            "positions that are not plain 32-bit floats (compressed or quantized: KHR_draco_mesh_compression, \
-             EXT_meshopt_compression or KHR_mesh_quantization; decompress the file first)",
+            "positions without data of their own or not 3-vectors (compressed: KHR_draco_mesh_compression or \
+             EXT_meshopt_compression; decompress the file first)",
         ));
     }
     if primitive
@@ -160,9 +187,9 @@ fn add_primitive(
         return Err(bad("indices that are not unsigned integers"));
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let read = reader.read_positions().ok_or_else(|| bad("positions reach past their buffer"))?;
+    let local = positions_of(&positions, |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice))?;
     let offset = surface.vertices.len();
-    surface.vertices.extend(read.map(|p| transform(world, p.map(f64::from))));
+    surface.vertices.extend(local.into_iter().map(|p| transform(world, p)));
     let count = surface.vertices.len() - offset;
     let indices: Vec<usize> = match primitive.indices() {
         Some(_) => {
@@ -180,6 +207,38 @@ fn add_primitive(
         surface.triangles.push(if mirrored { [a, c, b] } else { [a, b, c] });
     }
     Ok(())
+}
+
+/// The positions of `accessor` in the mesh's own frame: 32-bit floats, or the
+/// integers of `KHR_mesh_quantization`, normalized ones mapped to [−1, 1] or
+/// [0, 1] as glTF §3.11 says (`max(c / (2ⁿ⁻¹ − 1), −1)`, `c / (2ⁿ − 1)`).
+fn positions_of<'a, 's>(
+    accessor: &gltf::Accessor<'a>,
+    get: impl Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+) -> Result<Vec<[f64; 3]>, TetraError> {
+    fn read<'a, 's, T: Copy>(
+        accessor: &gltf::Accessor<'a>,
+        get: impl Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+        scale: impl Fn(T) -> f64,
+    ) -> Result<Vec<[f64; 3]>, TetraError>
+    where
+        [T; 3]: ::gltf::accessor::Item,
+    {
+        let iter = ::gltf::accessor::Iter::<[T; 3]>::new(accessor.clone(), get)
+            .ok_or_else(|| bad("positions reach past their buffer"))?;
+        Ok(iter.map(|p| p.map(&scale)).collect())
+    }
+    let n = accessor.normalized();
+    let signed = |c: f64, max: f64| if n { (c / max).max(-1.0) } else { c };
+    let unsigned = |c: f64, max: f64| if n { c / max } else { c };
+    match accessor.data_type() {
+        DataType::F32 => read::<f32>(accessor, get, f64::from),
+        DataType::I16 => read::<i16>(accessor, get, |c| signed(f64::from(c), 32767.0)),
+        DataType::U16 => read::<u16>(accessor, get, |c| unsigned(f64::from(c), 65535.0)),
+        DataType::I8 => read::<i8>(accessor, get, |c| signed(f64::from(c), 127.0)),
+        DataType::U8 => read::<u8>(accessor, get, |c| unsigned(f64::from(c), 255.0)),
+        DataType::U32 => Err(bad("positions of 32-bit integers (no extension allows them)")),
+    }
 }
 
 /// The triangles (counter-clockwise) of a triangle list, strip or fan.
