@@ -22,7 +22,7 @@
 
 use std::collections::HashMap;
 
-use crate::validate::{cross, dot, sub};
+use crate::validate::{cross, dot, find, sub};
 use crate::{Cells, Surface, TetMesh, TET10_EDGES};
 
 /// Outward faces of a positive tet, as local corner indices.
@@ -34,6 +34,11 @@ fn edge_slot(a: usize, b: usize) -> usize {
     4 + e.expect("corners of a tet edge")
 }
 
+/// Corner nodes of face `id` (`4·tet + face`), outward for a positive tet.
+fn face_corners(mesh: &TetMesh, id: usize) -> [usize; 3] {
+    TET_FACES[id % 4].map(|k| mesh.cells.corners(id / 4)[k])
+}
+
 /// Nodes closer than this times the bounding-box diagonal are one point
 /// when matching boundary faces (module doc).
 pub const COINCIDENT_NODE_TOLERANCE: f64 = 1e-10;
@@ -43,8 +48,7 @@ pub const COINCIDENT_NODE_TOLERANCE: f64 = 1e-10;
 /// [`COINCIDENT_NODE_TOLERANCE`], with another boundary face.
 fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
     let ids: Vec<usize> = (0..on_boundary.len()).filter(|&id| on_boundary[id]).collect();
-    let corners = |id: usize| TET_FACES[id % 4].map(|k| mesh.cells.corners(id / 4)[k]);
-    let mut nodes: Vec<usize> = ids.iter().flat_map(|&id| corners(id)).collect();
+    let mut nodes: Vec<usize> = ids.iter().flat_map(|&id| face_corners(mesh, id)).collect();
     nodes.sort_unstable();
     nodes.dedup();
     let point = |n: usize| mesh.nodes[n];
@@ -96,7 +100,7 @@ fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
     let mut keyed: Vec<([usize; 3], usize)> = ids
         .iter()
         .map(|&id| {
-            let mut key = corners(id).map(|n| representative[n]);
+            let mut key = face_corners(mesh, id).map(|n| representative[n]);
             key.sort_unstable();
             (key, id)
         })
@@ -114,19 +118,11 @@ fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
 /// volume `Σ a·(b × c)/6` is negative: a sealed cavity's wall (module doc).
 fn drop_cavity_walls(mesh: &TetMesh, on_boundary: &mut [bool]) {
     let ids: Vec<usize> = (0..on_boundary.len()).filter(|&id| on_boundary[id]).collect();
-    let corners = |id: usize| TET_FACES[id % 4].map(|k| mesh.cells.corners(id / 4)[k]);
     // Union–find over the faces, joined through their shared edges.
     let mut parent: Vec<usize> = (0..ids.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
     let mut edges: Vec<((usize, usize), usize)> = Vec::with_capacity(3 * ids.len());
     for (i, &id) in ids.iter().enumerate() {
-        let c = corners(id);
+        let c = face_corners(mesh, id);
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
             edges.push(((a.min(b), a.max(b)), i));
@@ -135,20 +131,20 @@ fn drop_cavity_walls(mesh: &TetMesh, on_boundary: &mut [bool]) {
     edges.sort_unstable();
     for run in edges.chunk_by(|a, b| a.0 == b.0) {
         for pair in run.windows(2) {
-            let (a, b) = (root(&mut parent, pair[0].1), root(&mut parent, pair[1].1));
+            let (a, b) = (find(&mut parent, pair[0].1), find(&mut parent, pair[1].1));
             parent[a.max(b)] = a.min(b);
         }
     }
     // About a boundary point, not the origin: a small part far from it would cancel.
     let Some(&first) = ids.first() else { return };
-    let origin = mesh.nodes[corners(first)[0]];
+    let origin = mesh.nodes[face_corners(mesh, first)[0]];
     let mut volume: HashMap<usize, f64> = HashMap::new();
     for (i, &id) in ids.iter().enumerate() {
-        let [a, b, c] = corners(id).map(|n| sub(mesh.nodes[n], origin));
-        *volume.entry(root(&mut parent, i)).or_default() += dot(a, cross(b, c)) / 6.0;
+        let [a, b, c] = face_corners(mesh, id).map(|n| sub(mesh.nodes[n], origin));
+        *volume.entry(find(&mut parent, i)).or_default() += dot(a, cross(b, c)) / 6.0;
     }
     for (i, &id) in ids.iter().enumerate() {
-        if volume[&root(&mut parent, i)] < 0.0 {
+        if volume[&find(&mut parent, i)] < 0.0 {
             on_boundary[id] = false;
         }
     }

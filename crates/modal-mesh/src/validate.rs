@@ -380,6 +380,16 @@ fn drop_unused_nodes(mesh: &mut TetMesh) -> usize {
     dropped
 }
 
+/// Root of `x` in the union–find forest `parent` (each entry its parent, a root
+/// its own), halving the path on the way.
+pub(crate) fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
 /// Connected parts of the mesh (tets sharing a node are connected).
 /// Returns the number of parts and, per node, its part id `0..count`
 /// (numbered in order of each part's lowest node); nodes used by no tet get
@@ -388,13 +398,6 @@ pub fn connected_parts(mesh: &TetMesh) -> (usize, Vec<usize>) {
     let n = mesh.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
     let mut used = vec![false; n];
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
     for e in 0..mesh.cells.len() {
         let nodes: Vec<usize> = mesh.cells.nodes_of(e).iter().copied().filter(|&k| k < n).collect();
         for &k in &nodes {
