@@ -127,10 +127,10 @@ impl TetBudget {
     }
 }
 
-/// True for file types that hold a surface to be tetrahedralized.
+/// True for file types that hold a surface to be tetrahedralized: the formats
+/// `modal_tetra` reads ([`modal_tetra::SurfaceFormat::from_path`]).
 pub fn is_surface_file(path: &Path) -> bool {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    matches!(ext.as_str(), "obj" | "stl" | "ply" | "glb" | "gltf")
+    modal_tetra::SurfaceFormat::from_path(path).is_some()
 }
 
 /// Loads, (tetrahedralizes,) scales and checks a mesh.
