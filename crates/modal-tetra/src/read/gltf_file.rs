@@ -186,8 +186,9 @@ fn add_primitive(
     {
         return Err(bad("indices that are not unsigned integers"));
     }
-    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let local = positions_of(&positions, |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice))?;
+    let get = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
+    let reader = primitive.reader(get);
+    let local = positions_of(&positions, get)?;
     let offset = surface.vertices.len();
     surface.vertices.extend(local.into_iter().map(|p| transform(world, p)));
     let count = surface.vertices.len() - offset;
