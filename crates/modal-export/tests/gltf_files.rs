@@ -272,6 +272,14 @@ fn malformed_files_and_models_give_one_clear_error() {
     bad_nu["extensions"][EXTENSION]["acousticMaterials"][0]["poissonRatio"] = 0.7.into();
     assert!(err(&bad_nu).contains("acoustic material 0"), "{}", err(&bad_nu));
 
+    // A compressed file's fallback buffer has neither data nor a URI: it must not
+    // be read as a second copy of the binary chunk.
+    let mut fallback = json.clone();
+    let length = fallback["buffers"][0]["byteLength"].clone();
+    fallback["buffers"].as_array_mut().unwrap().push(serde_json::json!({ "byteLength": length }));
+    fallback["bufferViews"][0]["buffer"] = 1.into();
+    assert!(err(&fallback).contains("buffer 1 has no data"), "{}", err(&fallback));
+
     let mut far_view = json.clone();
     let shapes = model(&mut far_view)["shapes"].as_u64().unwrap() as usize;
     far_view["accessors"][shapes]["count"] = 10_000_000.into();

@@ -146,32 +146,11 @@ struct Doc {
 impl Doc {
     fn open(bytes: &[u8], base: Option<&Path>) -> Result<Doc, ExportError> {
         let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| ExportError::Gltf(e.to_string()))?;
-        let mut buffers = Vec::new();
-        for buffer in gltf.buffers() {
-            let data = match buffer.source() {
-                gltf::buffer::Source::Bin => gltf
-                    .blob
-                    .clone()
-                    .ok_or_else(|| bad("buffer 0 is the GLB chunk, but the file has none"))?,
-                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                    return Err(bad("data: URI buffers are not supported (write a .glb)"))
-                }
-                gltf::buffer::Source::Uri(uri) => {
-                    let base = base.ok_or_else(|| bad(format!("buffer '{uri}' is an external file")))?;
-                    let path = base.join(uri);
-                    std::fs::read(&path).map_err(|source| ExportError::Read { path, source })?
-                }
-            };
-            if data.len() < buffer.length() {
-                return Err(bad(format!(
-                    "buffer {} holds {} bytes, {} declared",
-                    buffer.index(),
-                    data.len(),
-                    buffer.length()
-                )));
-            }
-            buffers.push(data);
-        }
+        // The geometry reader's loader, so a bank and a surface are read alike.
+        let buffers = modal_tetra::gltf_buffers(&gltf, base, bytes).map_err(|e| match e {
+            modal_tetra::TetraError::Io { path, source } => ExportError::Read { path, source },
+            other => bad(other.to_string()),
+        })?;
         Ok(Doc { gltf, buffers })
     }
 

@@ -39,7 +39,7 @@ type Matrix = [[f64; 4]; 4];
 pub(super) fn parse(bytes: &[u8], base: Option<&Path>) -> Result<TriSurface, TetraError> {
     let doc = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| bad(e.to_string()))?;
     validate(&doc).map_err(|e| bad(with_compression_hint(bytes, e)))?;
-    let buffers = buffers(&doc, base, bytes)?;
+    let buffers = gltf_buffers(&doc, base, bytes)?;
     let mut surface = TriSurface::default();
     let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -93,9 +93,14 @@ fn with_compression_hint(bytes: &[u8], message: String) -> String {
     }
 }
 
-/// Every buffer's bytes: the GLB's binary chunk or a file next to a `.gltf`
-/// (`bytes`: the whole file, for the error's hint).
-fn buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Result<Vec<Vec<u8>>, TetraError> {
+/// Every buffer's bytes, in the document's order: buffer 0 may be the GLB's
+/// binary chunk, any buffer a file named by its URI relative to `base` (the
+/// folder of a `.gltf`; `None` refuses external files). `bytes` is the whole
+/// file, for the error's hint. Refused: a buffer other than 0 without a URI
+/// (a compressed file's fallback, which holds no data), `data:` URIs and
+/// buffers shorter than they declare. Shared by the geometry reader here and
+/// the bank import of `modal-export`, so both read a container alike.
+pub fn gltf_buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Result<Vec<Vec<u8>>, TetraError> {
     doc.buffers()
         .map(|buffer| {
             let data = match buffer.source() {

@@ -12,6 +12,8 @@ mod obj;
 mod ply;
 mod stl;
 
+pub use gltf_file::gltf_buffers;
+
 use std::path::Path;
 
 use crate::{diagnose, SurfaceReport, TetraError, TriSurface};
