@@ -475,7 +475,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let wav = interrupt::guarded(|| modal_scene::write_wav(&rendered, &out, format))?;
     if wav.clipped > 0 {
-        warn(&format!("{} samples clipped at full scale (use --float)", wav.clipped));
+        warn(&clipping_advice(wav.clipped, rendered.report.peak, scene.listener.gain));
     }
     if let Some(path) = &args.events {
         interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))?;
@@ -545,4 +545,34 @@ fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, s
         report.impacts,
         report.peak
     );
+}
+
+/// The clipping warning, with the `[listener] gain` that would have fitted
+/// the peak (sample 1.0 is `20 Pa / gain`, so the peak scales with the gain).
+fn clipping_advice(clipped: usize, peak: f64, gain: f64) -> String {
+    // Two significant digits, rounded down so the advice does fit.
+    let fitting = gain * 0.9 / peak;
+    let exponent = fitting.log10().floor() - 1.0;
+    let fitting = (fitting / 10f64.powf(exponent)).floor() * 10f64.powf(exponent);
+    let decimals = (-exponent).max(0.0) as usize;
+    format!(
+        "{clipped} samples clipped at full scale: the peak is {peak:.2}× full scale (≈ {:.0} Pa); \
+         [listener] gain = {fitting:.decimals$} (now {gain}) would fit it, or --float keeps it unclipped",
+        peak * 20.0 / gain
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clipping_advice;
+
+    #[test]
+    fn the_clipping_advice_names_a_gain_that_fits_the_peak() {
+        // Peak 11.12× at gain 1: 0.9/11.12 = 0.0809… → 0.080, which fits.
+        let advice = clipping_advice(10_062, 11.12, 1.0);
+        assert!(advice.contains("gain = 0.080 (now 1)"), "{advice}");
+        assert!(advice.contains("≈ 222 Pa"), "{advice}");
+        // At gain 20 a peak of 1.5× fits at 12.
+        assert!(clipping_advice(3, 1.5, 20.0).contains("gain = 12 (now 20)"));
+    }
 }
