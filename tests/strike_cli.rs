@@ -66,6 +66,21 @@ fn strike_writes_a_wav_that_is_linear_in_the_impulse() {
             .ok()
             .json();
     assert!(auto["duration_s"].as_f64().unwrap() > 0.5);
+    // Without --at, the struck point is the surface point farthest from the centre of
+    // mass: a corner of the 0.3 × 0.02 × 0.012 m bar, and the tap is audible.
+    let run = modal(dir.path(), &["strike", "bar.bank", "-o", "corner.wav", "--json"]).ok();
+    assert!(run.stderr.contains("no --at, so struck at"), "{}", run.stderr);
+    let corner = run.json();
+    let at: Vec<f64> = corner["strikes"][0]["surface_point"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    for (c, ends) in at.iter().zip([[0.0, 0.3], [0.0, 0.02], [0.0, 0.012]]) {
+        assert!(ends.iter().any(|e| (c - e).abs() < 1e-9), "{at:?} is not a corner");
+    }
+    assert!(wav_samples(&dir.path().join("corner.wav")).iter().any(|&s| s.abs() > 100), "audible");
 }
 
 #[test]

@@ -330,7 +330,9 @@ pub struct StrikeArgs {
     /// Mode bank.
     pub bank: PathBuf,
     /// Struck point X,Y,Z [m] (snapped to the nearest surface point); repeat for several strikes.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, required = true, allow_hyphen_values = true)]
+    /// Default: one strike at the surface point farthest from the centre of mass (a rim, a tip, a
+    /// corner: where most modes move), printed on stderr.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub at: Vec<[f64; 3]>,
     /// Impulse direction X,Y,Z (default: into the surface); one, or one per --at.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]

@@ -99,10 +99,20 @@ fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f
 pub fn run(args: StrikeArgs) -> Result<()> {
     let bank = load_bank(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
-    let n = args.at.len();
+    let at_points = if args.at.is_empty() {
+        let at = farthest_surface_point(&bank).context("the bank has no surface to strike")?;
+        eprintln!(
+            "strike: no --at, so struck at ({:.4}, {:.4}, {:.4}) m, the surface point farthest from the centre of mass",
+            at[0], at[1], at[2]
+        );
+        vec![at]
+    } else {
+        args.at.clone()
+    };
+    let n = at_points.len();
     let mut strikes = Vec::with_capacity(n);
     let mut points_json = Vec::with_capacity(n);
-    for (k, &at) in args.at.iter().enumerate() {
+    for (k, &at) in at_points.iter().enumerate() {
         let point = model.locate(at).with_context(|| format!("--at {},{},{}", at[0], at[1], at[2]))?;
         let magnitude = nth(&args.impulse, k, DEFAULT_IMPULSE_NS, "impulse", n)?;
         ensure!(magnitude.is_finite() && magnitude >= 0.0, "--impulse must be a finite number >= 0 N·s");
@@ -198,6 +208,19 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     }
     print_human(&json);
     Ok(())
+}
+
+/// The surface node farthest from the centre of mass (the first of equals):
+/// the default struck point, where a rim, a tip or a corner moves in most
+/// modes. `None` for a bank without surface nodes.
+fn farthest_surface_point(bank: &ModeBank) -> Option<[f64; 3]> {
+    let c = bank.mass.center_of_mass_m;
+    let distance = |p: &[f64; 3]| (0..3).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>();
+    bank.surface
+        .positions
+        .iter()
+        .copied()
+        .reduce(|best, p| if distance(&p) > distance(&best) { p } else { best })
 }
 
 /// The loudest modes the first strike excites.
