@@ -333,7 +333,7 @@ fn unit_cube_glb(scale: [f64; 3]) -> Vec<u8> {
 }
 
 #[test]
-fn a_glb_without_a_modal_model_is_meshed_like_the_same_obj() {
+fn a_glb_or_off_without_a_modal_model_is_meshed_like_the_same_obj() {
     // Game assets come as glTF: one without the modal extension is geometry,
     // meshed and solved (one with it is read as a bank, as before).
     let dir = temp_dir();
@@ -351,4 +351,11 @@ fn a_glb_without_a_modal_model_is_meshed_like_the_same_obj() {
     let (from_glb, from_obj) = (solve("box.glb"), solve("box.obj"));
     assert_eq!(from_glb["dofs"], from_obj["dofs"]);
     assert_eq!(frequencies(&from_glb), frequencies(&from_obj), "the same mesh, the same modes");
+    // Datasets (ModelNet) come as OFF, with the keyword fused to the counts.
+    let cube = modal_tetra::shapes::cuboid(size[0], size[1], size[2]);
+    let mut off = format!("OFF{} {} 0\n", cube.vertices.len(), cube.triangles.len());
+    cube.vertices.iter().for_each(|p| off += &format!("{} {} {}\n", p[0], p[1], p[2]));
+    cube.triangles.iter().for_each(|t| off += &format!("3 {} {} {}\n", t[0], t[1], t[2]));
+    std::fs::write(dir.path().join("box.off"), off).unwrap();
+    assert_eq!(frequencies(&solve("box.off")), frequencies(&from_obj), "OFF: the same modes");
 }

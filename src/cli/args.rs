@@ -77,7 +77,7 @@ pub struct MeshInputArgs {
     /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres).
     #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
     pub scale: f64,
-    /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY); on a thin
+    /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY/OFF/glTF); on a thin
     /// shell (a wall thinner than the cell / 1.5), the longest tet edge along the wall.
     #[arg(long, value_name = "H")]
     pub cell: Option<f64>,
@@ -148,9 +148,9 @@ pub enum MeshShape {
     },
     /// Write the generated corpus of real-world-like surface assets (OBJ).
     Corpus(crate::cli::corpus::CorpusArgs),
-    /// Tetrahedralize a surface mesh (OBJ, STL, PLY).
+    /// Tetrahedralize a surface mesh (OBJ, STL, PLY, OFF, glTF).
     Tet {
-        /// Surface mesh to fill with tets (.obj, .stl, .ply, .glb, .gltf).
+        /// Surface mesh to fill with tets (.obj, .stl, .ply, .off, .glb, .gltf).
         input: PathBuf,
         /// Output .msh file (Gmsh 4.1).
         #[arg(short, long)]
@@ -192,7 +192,7 @@ pub struct GenerateArgs {
 
 #[derive(Debug, Args)]
 pub struct ExportMatricesArgs {
-    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply, .glb, .gltf).
+    /// Tet mesh (.msh, .node/.ele, .mesh) or surface mesh (.obj, .stl, .ply, .off, .glb, .gltf).
     pub mesh: PathBuf,
     /// Output directory (created).
     #[arg(long, short)]
@@ -208,7 +208,7 @@ pub struct ExportMatricesArgs {
 
 #[derive(Debug, Args)]
 pub struct PrecomputeArgs {
-    /// Tet mesh (.msh, .node/.ele, .mesh), surface mesh (.obj, .stl, .ply, or a .glb/.gltf
+    /// Tet mesh (.msh, .node/.ele, .mesh), surface mesh (.obj, .stl, .ply, .off, or a .glb/.gltf
     /// scene's meshes), or a .glb holding a modal model (read as the bank, no solve).
     pub mesh: PathBuf,
     /// Output mode bank (safetensors).

@@ -70,7 +70,7 @@ pub const BAND_MARGIN: f64 = 1.3;
 /// Warning for a prescribed tet mesh under an accuracy target.
 pub const PRESCRIBED_NOTE: &str =
     "no error estimate: a tet mesh file is solved as given (the estimate needs a \
-     second, coarser mesh of the same object; give the surface mesh (OBJ/STL/PLY) to get one)";
+     second, coarser mesh of the same object; give the surface mesh (OBJ/STL/PLY/OFF/glTF) to get one)";
 
 /// What `--accuracy` asks for.
 #[derive(Clone, Debug, PartialEq)]

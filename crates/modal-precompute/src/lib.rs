@@ -6,7 +6,7 @@
 //! happened on the way ([`Outcome`]: cache hit or miss, mesh report, warnings).
 //!
 //! Stages (each reported through the progress callback):
-//! 1. load — read the tet mesh, or tetrahedralize a surface mesh (OBJ/STL/PLY);
+//! 1. load — read the tet mesh, or tetrahedralize a surface mesh (OBJ/STL/PLY/OFF/glTF);
 //! 2. check — orientation, degeneracy, unused nodes, connected parts;
 //! 3. assemble — K and M at the requested order (default 2, quadratic tets);
 //! 4. solve — shift-invert block Lanczos with rigid modes deflated, inertia check;

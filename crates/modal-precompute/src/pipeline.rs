@@ -21,7 +21,7 @@ pub struct Request {
     pub source: MeshSource,
     /// Factor applied to all coordinates (e.g. 0.001 for millimetres).
     pub scale: f64,
-    /// Options for surface meshes (OBJ/STL/PLY).
+    /// Options for surface meshes (OBJ/STL/PLY/OFF/glTF).
     pub surface: SurfaceMeshing,
     /// Material, incl. Rayleigh damping.
     pub material: Material,

@@ -14,8 +14,8 @@ pub enum TetraError {
         /// Underlying I/O error.
         source: std::io::Error,
     },
-    /// The extension is not one of obj, stl, ply.
-    #[error("{path}: unsupported surface format (expected .obj, .stl or .ply)")]
+    /// The extension is not one of obj, stl, ply, off, glb, gltf.
+    #[error("{path}: unsupported surface format (expected .obj, .stl, .ply, .off, .glb or .gltf)")]
     UnsupportedFormat {
         /// File with the unknown extension.
         path: PathBuf,
@@ -23,7 +23,7 @@ pub enum TetraError {
     /// The third-party parser rejected the file (garbage, truncated, ...).
     #[error("{format} parse error: {message}")]
     Parse {
-        /// "OBJ", "STL" or "PLY".
+        /// "OBJ", "STL", "PLY", "OFF" or "glTF".
         format: &'static str,
         /// Parser message.
         message: String,

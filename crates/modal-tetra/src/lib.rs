@@ -1,4 +1,4 @@
-//! `modal-tetra`: surface meshes (OBJ/STL/PLY/glTF) in, quality tet meshes out.
+//! `modal-tetra`: surface meshes (OBJ/STL/PLY/OFF/glTF) in, quality tet meshes out.
 //!
 //! Inputs: a triangle surface file in metres ([`read_surface`]; `scale`
 //! multiplies, a unit warning points to `--scale`), possibly with holes,

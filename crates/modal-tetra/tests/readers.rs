@@ -1,4 +1,4 @@
-//! Reader tests: OBJ/STL/PLY round trips, parts, scale and unit warnings,
+//! Reader tests: OBJ/STL/PLY/OFF round trips, parts, scale and unit warnings,
 //! and hostile input that must give a typed error, never a panic.
 
 mod common;
@@ -76,6 +76,18 @@ fn ply_binary(s: &TriSurface) -> Vec<u8> {
     out
 }
 
+/// ASCII OFF as ModelNet writes it: the keyword fused with the counts.
+fn off_modelnet(s: &TriSurface) -> Vec<u8> {
+    let mut out = format!("OFF{} {} 0\n", s.vertices.len(), s.triangles.len());
+    for p in &s.vertices {
+        out += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &s.triangles {
+        out += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    out.into_bytes()
+}
+
 fn parse(bytes: &[u8], format: SurfaceFormat) -> Result<TriSurface, TetraError> {
     parse_surface(bytes, format, 1.0, None).map(|(s, _)| s)
 }
@@ -90,6 +102,7 @@ fn all_formats_read_the_same_sphere() {
         (stl_binary(&sphere), SurfaceFormat::Stl),
         (ply_ascii(&sphere), SurfaceFormat::Ply),
         (ply_binary(&sphere), SurfaceFormat::Ply),
+        (off_modelnet(&sphere), SurfaceFormat::Off),
     ] {
         let (s, report) = parse_surface(&bytes, format, 1.0, None).unwrap();
         assert_eq!(s.triangles.len(), 320, "{format:?}");
@@ -97,6 +110,8 @@ fn all_formats_read_the_same_sphere() {
         // f32 formats (binary STL, float PLY) round to ~1e-7 relative.
         assert!((report.enclosed_volume_m3 / volume - 1.0).abs() < 1e-5, "{format:?}");
     }
+    // OFF keeps every f64 bit (Rust prints the shortest string that reads back).
+    assert_eq!(parse(&off_modelnet(&sphere), SurfaceFormat::Off).unwrap().vertices, sphere.vertices);
 }
 
 #[test]
@@ -143,7 +158,7 @@ fn parts_are_kept_together_unless_one_is_chosen() {
 fn hostile_input_gives_typed_errors() {
     let sphere = shapes::icosphere(0.05, 1);
     let garbage: Vec<u8> = (0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
-    for format in [SurfaceFormat::Obj, SurfaceFormat::Stl, SurfaceFormat::Ply] {
+    for format in [SurfaceFormat::Obj, SurfaceFormat::Stl, SurfaceFormat::Ply, SurfaceFormat::Off] {
         assert!(parse(&garbage, format).is_err(), "{format:?} garbage");
         assert!(parse(b"", format).is_err(), "{format:?} empty");
     }
@@ -155,6 +170,11 @@ fn hostile_input_gives_typed_errors() {
     assert!(parse(&lying, SurfaceFormat::Stl).is_err());
     let ply = ply_binary(&sphere);
     assert!(parse(&ply[..ply.len() - 5], SurfaceFormat::Ply).is_err());
+    // Every truncation of an OFF file is an error, none a panic.
+    let off = off_modelnet(&sphere);
+    for end in (0..off.len() - 1).step_by(37) {
+        assert!(parse(&off[..end], SurfaceFormat::Off).is_err(), "OFF cut at {end}");
+    }
     let huge = b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n";
     assert!(parse(huge, SurfaceFormat::Ply).is_err());
     // NaN coordinate, index out of range, no triangles.

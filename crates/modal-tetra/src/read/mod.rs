@@ -1,6 +1,7 @@
 //! Surface readers: Wavefront OBJ (tobj), STL ASCII/binary (stl_io), PLY
-//! ASCII/binary (ply-rs-bw) and glTF 2.0 (gltf: the meshes a scene
-//! places), all into a [`TriSurface`] in metres.
+//! ASCII/binary (ply-rs-bw), OFF (ASCII, read here: see [`off`]) and glTF
+//! 2.0 (gltf: the meshes a scene places), all into a [`TriSurface`] in
+//! metres.
 //!
 //! Coordinates are taken as metres and never rescaled silently; `scale`
 //! multiplies them. Third-party parsers run under `catch_unwind` as a last
@@ -9,6 +10,7 @@
 
 mod gltf_file;
 mod obj;
+mod off;
 mod ply;
 mod stl;
 
@@ -27,6 +29,9 @@ pub enum SurfaceFormat {
     Stl,
     /// Stanford PLY, ASCII or binary (`vertex` x/y/z, `face` vertex_indices).
     Ply,
+    /// Geomview OFF, ASCII (ModelNet's and the Princeton Shape Benchmark's
+    /// format; polygons are triangulated).
+    Off,
     /// glTF 2.0, `.glb` or `.gltf` (the triangles of every mesh the default
     /// scene places, in world coordinates; each placed mesh is a part).
     Gltf,
@@ -40,6 +45,7 @@ impl SurfaceFormat {
             "obj" => Some(Self::Obj),
             "stl" => Some(Self::Stl),
             "ply" => Some(Self::Ply),
+            "off" => Some(Self::Off),
             "glb" | "gltf" => Some(Self::Gltf),
             _ => None,
         }
@@ -92,6 +98,7 @@ fn parse_surface_beside(
         SurfaceFormat::Obj => obj::parse(bytes),
         SurfaceFormat::Stl => stl::parse(bytes),
         SurfaceFormat::Ply => ply::parse(bytes),
+        SurfaceFormat::Off => off::parse(bytes),
         SurfaceFormat::Gltf => gltf_file::parse(bytes, folder),
     })?;
     surface.validate()?;
@@ -109,6 +116,7 @@ fn format_name(format: SurfaceFormat) -> &'static str {
         SurfaceFormat::Obj => "OBJ",
         SurfaceFormat::Stl => "STL",
         SurfaceFormat::Ply => "PLY",
+        SurfaceFormat::Off => "OFF",
         SurfaceFormat::Gltf => "glTF",
     }
 }
