@@ -13,7 +13,7 @@ fn steel() -> Material {
 /// The first `n` frequencies [Hz] of `source` (no cache, band wide open).
 fn frequencies(source: MeshSource, cell: Option<f64>, n: usize) -> Vec<f64> {
     let mut request = Request::new(source, steel());
-    request.surface = SurfaceMeshing { cell, part: None };
+    request.surface = SurfaceMeshing { cell, ..Default::default() };
     request.max_freq_hz = 1e7;
     request.max_modes = n;
     let outcome = precompute(&request, None, true, &mut |_| {}).expect("precompute");

@@ -84,6 +84,10 @@ pub struct MeshInputArgs {
     /// Object of a multi-object surface file to mesh (default: all, as one body).
     #[arg(long, value_name = "NAME")]
     pub part: Option<String>,
+    /// Give every open part of a surface mesh (a sheet modelled as one surface: a cymbal, a sign)
+    /// this wall thickness [m], so it is meshed as a closed thin shell; closed parts are kept.
+    #[arg(long, value_name = "M")]
+    pub sheet_thickness: Option<f64>,
 }
 
 #[derive(Debug, Args)]
@@ -165,6 +169,9 @@ pub enum MeshShape {
         /// Object of a multi-object file to mesh.
         #[arg(long)]
         part: Option<String>,
+        /// Give every open part (a sheet modelled as one surface) this wall thickness [m].
+        #[arg(long, value_name = "M")]
+        sheet_thickness: Option<f64>,
         /// Print a JSON report on stdout.
         #[arg(long)]
         json: bool,

@@ -20,11 +20,14 @@ pub fn run(shape: MeshShape) -> Result<()> {
         MeshShape::Sphere { radius, common } => generate(Shape::Sphere { radius }, common),
         MeshShape::Bowl { radius, thickness, common } => generate(Shape::Bowl { radius, thickness }, common),
         MeshShape::Corpus(args) => super::corpus::run(args),
-        MeshShape::Tet { input, out, cell, scale, part, json } => {
-            let (surface, report) = modal_tetra::read_surface(&input, scale, part.as_deref())
+        MeshShape::Tet { input, out, cell, scale, part, sheet_thickness, json } => {
+            let (surface, mut report) = modal_tetra::read_surface(&input, scale, part.as_deref())
                 .with_context(|| format!("cannot read surface mesh {}", input.display()))?;
+            if sheet_thickness.is_some() {
+                report.drop_open_warning();
+            }
             report.warnings.iter().for_each(|w| warn(w));
-            let options = modal_tetra::TetOptions { cell, ..Default::default() };
+            let options = modal_tetra::TetOptions { cell, sheet_thickness, ..Default::default() };
             let (mesh, tet_report) = modal_tetra::tetrahedralize(&surface, &options)
                 .with_context(|| format!("cannot tetrahedralize {}", input.display()))?;
             write_mesh(&out, &mesh)?;
@@ -50,6 +53,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
                 "min_thickness_m": r.min_thickness_m,
                 "max_surface_gap_m": r.max_surface_gap_m,
                 "wall_layers": r.wall_layers,
+                "sheets_thickened": r.sheets_thickened,
             });
             if json {
                 print_json(&summary)
@@ -67,6 +71,13 @@ pub fn run(shape: MeshShape) -> Result<()> {
                     r.surface_volume_m3,
                     r.max_surface_deviation_m
                 );
+                if r.sheets_thickened > 0 {
+                    println!(
+                        "sheets: {} open part(s) given a {:.3e} m wall",
+                        r.sheets_thickened,
+                        sheet_thickness.unwrap_or(f64::NAN)
+                    );
+                }
                 if report.cavities > 0 {
                     println!("hollow: {} inner wall(s) facing inward bound cavities", report.cavities);
                 }

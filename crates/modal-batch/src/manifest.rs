@@ -58,6 +58,8 @@ pub struct Options {
     pub cell: Option<f64>,
     /// Object of a multi-object surface file.
     pub part: Option<String>,
+    /// Wall thickness \[m\] given to open parts (sheets modelled as one surface).
+    pub sheet_thickness: Option<f64>,
     /// Per-mode error estimate of surface meshes and the accuracy to reach, as
     /// `modal precompute --accuracy` (unset everywhere: its default, 1 %).
     pub accuracy: Option<Accuracy>,
@@ -116,6 +118,7 @@ impl Options {
             max_freq: self.max_freq.or(base.max_freq),
             cell: self.cell.or(base.cell),
             part: self.part.clone().or_else(|| base.part.clone()),
+            sheet_thickness: self.sheet_thickness.or(base.sheet_thickness),
             accuracy: self.accuracy.or(base.accuracy),
             transfer_max_freq: self.transfer_max_freq.or(base.transfer_max_freq),
         }
@@ -144,6 +147,7 @@ struct Table {
     max_freq: Option<f64>,
     cell: Option<f64>,
     part: Option<String>,
+    sheet_thickness: Option<f64>,
     accuracy: Option<AccuracyKey>,
     transfer_max_freq: Option<f64>,
 }
@@ -164,6 +168,7 @@ impl Table {
             max_freq: self.max_freq,
             cell: self.cell,
             part: self.part.clone(),
+            sheet_thickness: self.sheet_thickness,
             accuracy: self.accuracy.as_ref().map(AccuracyKey::parse).transpose()?,
             transfer_max_freq: self.transfer_max_freq,
         })
@@ -341,7 +346,8 @@ impl Manifest {
         request.max_modes = o.modes.unwrap_or(request.max_modes);
         request.min_freq_hz = o.min_freq.unwrap_or(request.min_freq_hz);
         request.max_freq_hz = o.max_freq.unwrap_or(request.max_freq_hz);
-        request.surface = SurfaceMeshing { cell: o.cell, part: o.part.clone() };
+        request.surface =
+            SurfaceMeshing { cell: o.cell, part: o.part.clone(), sheet_thickness: o.sheet_thickness };
         request.accuracy = match o.accuracy.unwrap_or(Accuracy::Target(AccuracyTarget::default().target_pct))
         {
             Accuracy::Target(target_pct) => Some(AccuracyTarget { target_pct, ..AccuracyTarget::default() }),
@@ -384,6 +390,9 @@ fn check_request(r: &Request, o: &Options) -> Result<(), String> {
     }
     if o.cell.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
         return Err(format!("`cell` must be a positive length in metres, got {}", o.cell.unwrap_or(0.0)));
+    }
+    if let Some(t) = o.sheet_thickness.filter(|t| !(t.is_finite() && *t > 0.0)) {
+        return Err(format!("`sheet_thickness` must be a positive length in metres, got {t}"));
     }
     Ok(())
 }
@@ -456,6 +465,7 @@ mod tests {
             material = "glass"
             scale = 0.001
             cell = 0.5
+            sheet_thickness = 0.002
             [[assets]]
             path = "../shared/x.msh"
             bank = "shared_x.bank"
@@ -471,7 +481,7 @@ mod tests {
         let a = &assets[0].request;
         assert_eq!(a.material.name.as_deref(), Some("glass"));
         assert_eq!((a.scale, a.order, a.max_modes, a.max_freq_hz), (0.001, 1, 8, 20_000.0));
-        assert_eq!(a.surface.cell, Some(0.5));
+        assert_eq!((a.surface.cell, a.surface.sheet_thickness), (Some(0.5), Some(0.002)));
         let b = &assets[1].request;
         assert_eq!(b.material.name.as_deref(), Some("wood"));
         assert_eq!((b.scale, b.order, b.max_modes, b.max_freq_hz), (1.0, 1, 8, 8000.0));
@@ -505,6 +515,8 @@ mod tests {
         assert!(err("[[globs]]\npattern = \"../*.obj\"\nmaterial = \"steel\"").contains(".."));
         assert!(err("[[assets]]\npath = \"a.obj\"\nmaterial = \"steel\"\nscale = -1").contains("scale"));
         assert!(err("[[assets]]\npath = \"a.obj\"\nmaterial = \"steel\"\ncell = 0").contains("cell"));
+        let thin = "[[assets]]\npath = \"a.obj\"\nmaterial = \"steel\"\nsheet_thickness = -1";
+        assert!(err(thin).contains("sheet_thickness"), "{}", err(thin));
     }
 
     #[test]

@@ -28,12 +28,19 @@ pub struct SurfaceMeshing {
     pub cell: Option<f64>,
     /// Object of a multi-object surface file; `None` meshes all as one body.
     pub part: Option<String>,
+    /// Wall thickness [m] given to open parts (sheets modelled as one
+    /// surface): `modal_tetra::TetOptions::sheet_thickness`.
+    pub sheet_thickness: Option<f64>,
 }
 
 impl SurfaceMeshing {
     /// The mesher options these settings stand for.
     pub fn tet_options(&self) -> modal_tetra::TetOptions {
-        modal_tetra::TetOptions { cell: self.cell, ..Default::default() }
+        modal_tetra::TetOptions {
+            cell: self.cell,
+            sheet_thickness: self.sheet_thickness,
+            ..Default::default()
+        }
     }
 }
 
@@ -159,7 +166,10 @@ pub(crate) fn load_mesh_sized(
     let (mut cell_m, mut layered) = (None, false);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
-            let (surf, report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
+            let (surf, mut report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
+            if surface.sheet_thickness.is_some() {
+                report.drop_open_warning();
+            }
             warnings.extend(report.warnings.iter().cloned());
             let mut options = surface.tet_options();
             match level {

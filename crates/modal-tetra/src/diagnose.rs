@@ -280,9 +280,19 @@ fn open_warning(open_edges: usize) -> Option<String> {
         format!(
             "the surface is open ({open_edges} edges belong to one triangle only): it is meshed as the solid its \
              winding number encloses, so holes are capped and an open shell is filled; close the surface, or give \
-             a sheet its thickness, if that is not the object"
+             a sheet its thickness (--sheet-thickness M), if that is not the object"
         )
     })
+}
+
+impl SurfaceReport {
+    /// Removes the open-surface warning: for a caller that gives open parts a
+    /// thickness (`TetOptions::sheet_thickness`), where it does not hold.
+    pub fn drop_open_warning(&mut self) {
+        if let Some(w) = open_warning(self.open_boundary_edges) {
+            self.warnings.retain(|x| *x != w);
+        }
+    }
 }
 
 fn unit_warning(diagonal: f64) -> Option<String> {

@@ -74,6 +74,7 @@ mod sizing;
 mod smooth;
 mod stuff;
 mod surface;
+mod thicken;
 mod wall_rule;
 
 pub use curve::{MAX_BULGE, MIN_JACOBIAN_RATIO};
@@ -91,6 +92,7 @@ pub use read::{gltf_buffers, parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};
 pub use stuff::{ALPHA_LONG, ALPHA_SHORT};
 pub use surface::{write_obj, TriSurface};
+pub use thicken::MAX_MITRE;
 
 /// Bounds every uniform output of [`tetrahedralize`] is tested against (degrees).
 pub const DIHEDRAL_BOUNDS_DEG: (f64, f64) = (9.0, 166.0);

@@ -16,6 +16,7 @@ use crate::second_try::Smoothed;
 use crate::shell::{layered, LayerSizing, Layered, NotLayered};
 use crate::sizing::{surface_gap, Sizing};
 use crate::stuff::{background, stuff, Stuffed};
+use crate::thicken::thicken_open_sheets;
 use crate::{TetraError, TriSurface};
 
 /// Default resolution: cell size = bounding-box diagonal / this, and at most
@@ -86,6 +87,11 @@ pub struct TetOptions {
     /// 2 coarsens the whole mesh by two, ½ refines it (two-level error
     /// estimates use it).
     pub size_factor: f64,
+    /// Give every open part (a component with a boundary edge) this wall
+    /// thickness [m] before meshing: a sheet modelled as one surface (a
+    /// cymbal, a sign) becomes a closed shell (module `thicken`). `None`
+    /// (default): open parts are filled as their winding number encloses.
+    pub sheet_thickness: Option<f64>,
 }
 
 impl Default for TetOptions {
@@ -101,6 +107,7 @@ impl Default for TetOptions {
             graded: false,
             default_max_tets: DEFAULT_MAX_TETS,
             size_factor: 1.0,
+            sheet_thickness: None,
         }
     }
 }
@@ -120,7 +127,7 @@ impl TetOptions {
             self.graded,
             self.default_max_tets,
             self.size_factor
-        )
+        ) + &self.sheet_thickness.map(|t| format!(";sheet_thickness={t}")).unwrap_or_default()
     }
 }
 
@@ -179,6 +186,8 @@ pub struct TetReport {
     /// the longest edge along the wall and `min_thickness_m` the median
     /// wall); 0 when stuffed.
     pub wall_layers: usize,
+    /// Open parts given [`TetOptions::sheet_thickness`] (0 without it).
+    pub sheets_thickened: usize,
     /// What the user should know about the mesh (one line each).
     pub warnings: Vec<String>,
 }
@@ -306,6 +315,12 @@ pub fn tetrahedralize(
     options: &TetOptions,
 ) -> Result<(TetMesh, TetReport), TetraError> {
     surface.validate()?;
+    let thickened = match options.sheet_thickness {
+        Some(t) => Some(thicken_open_sheets(surface, t)?),
+        None => None,
+    };
+    let sheets_thickened = thickened.as_ref().map_or(0, |(_, report)| report.sheets);
+    let surface = thickened.as_ref().map_or(surface, |(thick, _)| thick);
     let repaired = repair(surface);
     if repaired.triangles.is_empty() {
         return Err(TetraError::Empty);
@@ -393,6 +408,7 @@ pub fn tetrahedralize(
         hinged_tets_dropped: hinged.tets,
         hinges_split: hinged.split,
         wall_layers,
+        sheets_thickened,
         warnings: warnings.into_iter().chain(hinged.warnings).collect(),
     };
     Ok((mesh, report))
@@ -532,7 +548,7 @@ fn stuff_surface(
         if volume <= SHEET_VOLUME * diagonal.powi(3) {
             return Err(TetraError::NoVolume {
                 cell_m: h0,
-                hint: "the surface encloses no volume at all (an open sheet without thickness): close it or give it a thickness".into(),
+                hint: "the surface encloses no volume at all (an open sheet without thickness): close it, or give it a thickness (--sheet-thickness M)".into(),
             });
         }
         // Thinner than the cell: try finer cells (within the size limit).

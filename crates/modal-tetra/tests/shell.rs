@@ -14,8 +14,12 @@ use modal_tetra::{shapes, tetrahedralize, TetOptions, TriSurface};
 
 /// The lowest `count` elastic frequencies of a 10-node mesh of glass [Hz].
 fn frequencies(mesh: &TetMesh, count: usize) -> Vec<f64> {
-    let material = Material::custom(62e9, 0.24, 2500.0, 0.0, 0.0).unwrap();
-    let a = assemble(mesh, &material).unwrap();
+    frequencies_in(mesh, &Material::custom(62e9, 0.24, 2500.0, 0.0, 0.0).unwrap(), count)
+}
+
+/// The lowest `count` elastic frequencies of a 10-node mesh of `material` [Hz].
+fn frequencies_in(mesh: &TetMesh, material: &Material, count: usize) -> Vec<f64> {
+    let a = assemble(mesh, material).unwrap();
     let (part, parts) = node_parts(mesh);
     let rigid = rigid_body_fields(&mesh.nodes, &part, parts, &[]);
     let options = EigenOptions { max_modes: count, max_freq_hz: 1e6, ..Default::default() };
@@ -154,6 +158,73 @@ fn a_hollow_ball_is_one_body_in_layers_and_rings_like_a_thin_spherical_shell() {
         assert!(common::rel(*f, want).abs() < 0.015, "{f} Hz against {want} Hz");
     }
     assert!(common::rel(ours[5], want) > 0.05, "a sixth n = 2 mode: {ours:?}");
+}
+
+/// A flat disc of `radius` in the plane z = `z` as `rings` rings of
+/// `segments` triangles (faces up; `down` reverses them).
+fn disc(radius: f64, z: f64, rings: usize, segments: usize, down: bool) -> TriSurface {
+    let mut s = TriSurface { vertices: vec![[0.0, 0.0, z]], ..Default::default() };
+    for i in 1..=rings {
+        for j in 0..segments {
+            let (r, a) =
+                (radius * i as f64 / rings as f64, std::f64::consts::TAU * j as f64 / segments as f64);
+            s.vertices.push([r * a.cos(), r * a.sin(), z]);
+        }
+    }
+    let at = |i: usize, j: usize| if i == 0 { 0 } else { 1 + (i - 1) * segments + j % segments };
+    for j in 0..segments {
+        s.triangles.push([at(0, 0), at(1, j), at(1, j + 1)]);
+        for i in 1..rings {
+            s.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            s.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    if down {
+        s.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    s.parts.push(("disc".into(), 0..s.triangles.len()));
+    s
+}
+
+#[test]
+fn an_open_disc_given_a_sheet_thickness_rings_like_a_free_kirchhoff_plate() {
+    // A cymbal or a sign in a game asset is often one surface without
+    // thickness: filled by its winding number it encloses nothing. Given a
+    // thickness it becomes the closed plate, meshed in layers.
+    let (radius, h) = (0.06, 0.002);
+    let sheet = disc(radius, 0.0, 8, 48, false);
+    let options = TetOptions { sheet_thickness: Some(h), ..Default::default() };
+    let (mesh, report) = tetrahedralize(&sheet, &options).unwrap();
+    assert_eq!((report.sheets_thickened, report.wall_layers), (1, 1), "{report:?}");
+    let area = common::rel(report.volume_m3, std::f64::consts::PI * radius * radius * h);
+    assert!(area.abs() < 0.01, "volume off by {area}");
+    assert!(tetrahedralize(&sheet, &TetOptions::default()).is_err(), "no thickness: nothing enclosed");
+    // The same plate built closed (two faces and a rim) meshes to the same modes.
+    let mut closed = disc(radius, 0.5 * h, 8, 48, false);
+    let bottom = disc(radius, -0.5 * h, 8, 48, true);
+    let shift = closed.vertices.len();
+    closed.vertices.extend(&bottom.vertices);
+    closed.triangles.extend(bottom.triangles.iter().map(|t| t.map(|v| v + shift)));
+    let rim = 1 + 7 * 48;
+    for j in 0..48 {
+        let (a, b) = (rim + j, rim + (j + 1) % 48);
+        closed.triangles.extend([[a, a + shift, b + shift], [a, b + shift, b]]);
+    }
+    // Brass (ν = 0.33, the Poisson ratio of the plate tables).
+    let brass = Material::custom(1e11, 0.33, 8500.0, 0.0, 0.0).unwrap();
+    let (checked, _) = modal_mesh::check(mesh).unwrap();
+    let ours = frequencies_in(&checked, &brass, 5);
+    let (closed_mesh, _) = tetrahedralize(&closed, &TetOptions::default()).unwrap();
+    let (closed_mesh, _) = modal_mesh::check(closed_mesh).unwrap();
+    let built = frequencies_in(&closed_mesh, &brass, 5);
+    assert!(worst_rel(&ours, &built) < 1e-6, "sheet {ours:?} against closed {built:?}");
+    // Free circular Kirchhoff plate (Leissa 1969, ν = 0.33): f = λ²/(2πa²)·√(D/ρh),
+    // λ² = 5.253 (2 nodal diameters, a pair), 9.084 (one nodal circle), 12.23 (3, a pair).
+    let d = 1e11 * h.powi(3) / (12.0 * (1.0 - 0.33f64.powi(2)));
+    let scale = (d / (8500.0 * h)).sqrt() / (std::f64::consts::TAU * radius * radius);
+    let want = [5.253, 5.253, 9.084, 12.23, 12.23].map(|l2| l2 * scale);
+    println!("open disc given {h} m: ours {ours:.1?}, Kirchhoff {want:.1?}");
+    assert!(worst_rel(&ours, &want) < 0.015, "{ours:?} against {want:?}");
 }
 
 #[test]

@@ -103,6 +103,9 @@ fn options_control_resolution_and_guard_size() {
     assert_ne!(a, TetOptions { curved: false, ..Default::default() }.cache_key_fields());
     let b = TetOptions { cell: Some(0.01), ..Default::default() }.cache_key_fields();
     assert_ne!(a, b);
+    // A sheet thickness changes the mesh, so the key; without one the key is the old one.
+    assert_ne!(a, TetOptions { sheet_thickness: Some(0.002), ..Default::default() }.cache_key_fields());
+    assert!(!a.contains("sheet"), "{a}");
 }
 
 #[test]

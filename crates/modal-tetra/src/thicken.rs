@@ -1,0 +1,222 @@
+//! Open sheets given a thickness (`--sheet-thickness`).
+//!
+//! Game and CAD assets often model sheet-like objects (a cymbal, a gong, a
+//! sign, a leaf, sheet metal) as one surface with no thickness. As a solid
+//! such a surface encloses nothing, and its winding number fills an
+//! arbitrary slab. Given the real thickness `t`, every open part (an
+//! edge-connected component with a boundary edge) becomes a closed shell:
+//! two offset copies of it, `x ± d(x)·t/2`, the lower one reversed so both
+//! face out, joined along every boundary edge by a strip of two triangles.
+//! The shell then meshes like any thin wall (in layers, module `shell`).
+//!
+//! The offset direction at a vertex is the area-weighted mean of its
+//! triangles' normals, lengthened by `1 / min_f (n̂·n_f)` (at most 2) so the
+//! wall keeps its thickness across a crease (a mitre: `√2` at a 90° fold).
+//! Closed parts are kept as they are, so a solid with a sheet attached (a
+//! post and its sign) is the union of both.
+
+use std::collections::HashMap;
+
+use crate::diagnose::repair;
+use crate::geom::{add, area_vector, dot, norm, scale, V3};
+use crate::{TetraError, TriSurface};
+
+/// Largest mitre factor of an offset (a fold sharper than 120° gets no more).
+pub const MAX_MITRE: f64 = 2.0;
+
+/// What thickening did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Thickened {
+    /// Open parts turned into shells.
+    pub(crate) sheets: usize,
+    /// Their area, one side [m²].
+    pub(crate) sheet_area_m2: f64,
+}
+
+/// `surface` with every open part a closed shell of `thickness_m` (module doc).
+pub(crate) fn thicken_open_sheets(
+    surface: &TriSurface,
+    thickness_m: f64,
+) -> Result<(TriSurface, Thickened), TetraError> {
+    if !(thickness_m.is_finite() && thickness_m > 0.0) {
+        return Err(TetraError::InvalidOption {
+            name: "sheet thickness",
+            reason: format!("{thickness_m} is not a positive length in metres"),
+        });
+    }
+    // Welded, degenerate triangles dropped, each component oriented consistently.
+    let repaired = repair(surface);
+    let (vertices, triangles) = (&repaired.vertices, &repaired.triangles);
+    let edges = edge_triangles(triangles);
+    let component = components(triangles, &edges);
+    let mut open = vec![false; component.iter().max().map_or(0, |&c| c + 1)];
+    for tris in edges.values().filter(|t| t.len() == 1) {
+        open[component[tris[0]]] = true;
+    }
+    let mut out = TriSurface { vertices: vertices.clone(), ..Default::default() };
+    let mut report = Thickened { sheets: open.iter().filter(|&&o| o).count(), ..Default::default() };
+    // Per vertex of an open part: the indices of its upper and lower copies.
+    let mut copies: HashMap<usize, (usize, usize)> = HashMap::new();
+    let offsets = offset_directions(vertices, triangles, |t| open[component[t]]);
+    for (t, tri) in triangles.iter().enumerate() {
+        if !open[component[t]] {
+            out.triangles.push(*tri);
+            continue;
+        }
+        report.sheet_area_m2 += norm(area_vector(vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]));
+        let [a, b, c] = tri.map(|v| {
+            *copies.entry(v).or_insert_with(|| {
+                let d = scale(offsets[&v], 0.5 * thickness_m);
+                out.vertices.push(add(vertices[v], d));
+                out.vertices.push(add(vertices[v], scale(d, -1.0)));
+                (out.vertices.len() - 2, out.vertices.len() - 1)
+            })
+        });
+        out.triangles.push([a.0, b.0, c.0]);
+        out.triangles.push([a.1, c.1, b.1]);
+    }
+    // Rims: each boundary edge a → b (in its triangle's order) gets the strip
+    // (a⁺, a⁻, b⁻), (a⁺, b⁻, b⁺), which faces out across the edge.
+    let mut rims: Vec<(usize, usize)> = edges
+        .iter()
+        .filter(|(_, t)| t.len() == 1)
+        .map(|(&(u, v), t)| directed(triangles[t[0]], u, v))
+        .collect();
+    rims.sort_unstable();
+    for (a, b) in rims {
+        let ((a_up, a_down), (b_up, b_down)) = (copies[&a], copies[&b]);
+        out.triangles.push([a_up, a_down, b_down]);
+        out.triangles.push([a_up, b_down, b_up]);
+    }
+    out.parts.push(("surface".to_string(), 0..out.triangles.len()));
+    Ok((out, report))
+}
+
+/// Triangles on each undirected edge `(min, max)`.
+fn edge_triangles(triangles: &[[usize; 3]]) -> HashMap<(usize, usize), Vec<usize>> {
+    let mut edges: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (u, v) = (tri[k], tri[(k + 1) % 3]);
+            edges.entry((u.min(v), u.max(v))).or_default().push(t);
+        }
+    }
+    edges
+}
+
+/// The edge-connected component of every triangle.
+fn components(triangles: &[[usize; 3]], edges: &HashMap<(usize, usize), Vec<usize>>) -> Vec<usize> {
+    let mut component = vec![usize::MAX; triangles.len()];
+    let mut count = 0;
+    for seed in 0..triangles.len() {
+        if component[seed] != usize::MAX {
+            continue;
+        }
+        component[seed] = count;
+        let mut stack = vec![seed];
+        while let Some(t) = stack.pop() {
+            for k in 0..3 {
+                let (u, v) = (triangles[t][k], triangles[t][(k + 1) % 3]);
+                for &n in &edges[&(u.min(v), u.max(v))] {
+                    if component[n] == usize::MAX {
+                        component[n] = count;
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+        count += 1;
+    }
+    component
+}
+
+/// Edge `{u, v}` in the order triangle `tri` runs along it.
+fn directed(tri: [usize; 3], u: usize, v: usize) -> (usize, usize) {
+    let k = tri.iter().position(|&x| x == u).unwrap_or(0);
+    if tri[(k + 1) % 3] == v {
+        (u, v)
+    } else {
+        (v, u)
+    }
+}
+
+/// The mitred offset direction (module doc) of every vertex of the
+/// triangles `selected` picks.
+fn offset_directions(
+    vertices: &[V3],
+    triangles: &[[usize; 3]],
+    selected: impl Fn(usize) -> bool,
+) -> HashMap<usize, V3> {
+    let mut sums: HashMap<usize, (V3, Vec<V3>)> = HashMap::new();
+    for (_, tri) in triangles.iter().enumerate().filter(|&(t, _)| selected(t)) {
+        let area = area_vector(vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
+        let unit = scale(area, 1.0 / norm(area));
+        for &v in tri {
+            let entry = sums.entry(v).or_insert(([0.0; 3], Vec::new()));
+            entry.0 = add(entry.0, area);
+            entry.1.push(unit);
+        }
+    }
+    sums.into_iter()
+        .map(|(v, (sum, normals))| {
+            // Faces that cancel (a sheet folded flat onto itself): take the first face's normal.
+            let mean = if norm(sum) > 0.0 { scale(sum, 1.0 / norm(sum)) } else { normals[0] };
+            let worst = normals.iter().map(|&n| dot(mean, n)).fold(1.0, f64::min);
+            (v, scale(mean, 1.0 / worst.max(1.0 / MAX_MITRE)))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> TriSurface {
+        TriSurface {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            parts: vec![("sheet".into(), 0..2)],
+        }
+    }
+
+    #[test]
+    fn a_square_sheet_becomes_a_closed_slab_of_the_thickness() {
+        let (slab, report) = thicken_open_sheets(&square(), 0.1).unwrap();
+        assert_eq!(report, Thickened { sheets: 1, sheet_area_m2: 1.0 });
+        let diagnosis = crate::diagnose(&slab);
+        assert_eq!(diagnosis.open_boundary_edges, 0, "{diagnosis:?}");
+        assert!((diagnosis.enclosed_volume_m3 - 0.1).abs() < 1e-12, "{}", diagnosis.enclosed_volume_m3);
+        assert_eq!(slab.triangles.len(), 4 + 8);
+    }
+
+    #[test]
+    fn a_fold_keeps_the_wall_thickness_and_closed_parts_are_kept() {
+        // An L of two unit squares folded at 90° along the y axis: the mitre keeps the
+        // wall 0.1 thick on both legs, so the volume is 2 × 0.1 less the corner's overlap.
+        let mut l = square();
+        l.vertices.extend([[0.0, 0.0, 1.0], [0.0, 1.0, 1.0]]);
+        l.triangles.extend([[0, 3, 5], [0, 5, 4]]);
+        let cube = crate::shapes::cuboid(0.1, 0.1, 0.1);
+        let shift = l.vertices.len();
+        l.vertices.extend(cube.vertices.iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
+        l.triangles.extend(cube.triangles.iter().map(|t| t.map(|v| v + shift)));
+        let (out, report) = thicken_open_sheets(&l, 0.1).unwrap();
+        assert_eq!(report.sheets, 1, "the cube is closed and kept");
+        let diagnosis = crate::diagnose(&out);
+        assert_eq!(diagnosis.open_boundary_edges, 0);
+        // The L's cross-section: two 1 × 0.1 legs centred on the sheet, a mitred corner.
+        let l_volume = 2.0 * 0.1 * 1.0;
+        assert!(
+            (diagnosis.enclosed_volume_m3 - (l_volume + 1e-3)).abs() < 1e-9,
+            "{}",
+            diagnosis.enclosed_volume_m3
+        );
+    }
+
+    #[test]
+    fn a_thickness_that_is_not_a_length_is_refused() {
+        for t in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(thicken_open_sheets(&square(), t), Err(TetraError::InvalidOption { .. })));
+        }
+    }
+}
