@@ -35,8 +35,12 @@
 //! layer of prisms across the wall, three tets each, with edges along the
 //! wall of at most [`LAYERED_CELL_PER_WALL`] thicknesses (or `cell`), up to
 //! [`LAYERED_STRAIGHT_CELL_PER_WALL`] along directions in which the wall of
-//! a slender shell, curved across them, is straight (a chime's axis); a solid that is no
-//! shell (a handle, a thick foot) is stuffed as before.
+//! a slender shell, curved across them, is straight (a chime's axis), and
+//! where the wall is flat (a plate, a cymbal) up to
+//! [`FLAT_CELLS_PER_WAVELENGTH`] edges per bending wavelength of the
+//! [`FLAT_RESOLVED_MODES`]-th mode when that is longer; a solid that is no
+//! shell (a handle, a thick foot) is stuffed as before. Open parts given
+//! [`TetOptions::sheet_thickness`] become such shells first (module `thicken`).
 //!
 //! Resolution: [`TetOptions::cell`] (the BCC cube edge h), else
 //! [`TetOptions::target_tets`], else
@@ -93,6 +97,7 @@ pub use sizing::{CONE_DEG, GRADING};
 pub use stuff::{ALPHA_LONG, ALPHA_SHORT};
 pub use surface::{write_obj, TriSurface};
 pub use thicken::MAX_MITRE;
+pub use wall_rule::{FLAT_CELLS_PER_WAVELENGTH, FLAT_RESOLVED_MODES};
 
 /// Bounds every uniform output of [`tetrahedralize`] is tested against (degrees).
 pub const DIHEDRAL_BOUNDS_DEG: (f64, f64) = (9.0, 166.0);

@@ -117,7 +117,7 @@ impl TetOptions {
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
         format!(
-            "tetra=stuffing-v10;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
+            "tetra=stuffing-v11;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
             self.cell,
             self.target_tets,
             self.cells_per_diagonal,

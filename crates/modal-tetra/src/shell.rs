@@ -152,14 +152,14 @@ pub(crate) fn layered(
     let (master, opposite) = (&skins.master, &skins.opposite);
     let wall_m = skins.median_wall();
     let master_points: Vec<V3> = master.iter().flat_map(|&t| triangles[t].map(|v| vertices[v])).collect();
-    let limits = EdgeLimits::new(&sizing, wall_m, slender_length(&master_points));
-    let layers = ((wall_m / limits.curved_m).round() as usize).max(1);
     let master_area = skins.master_area();
-    // Refined triangles ≥ area / (√3/4 · h_straight²); three tets per prism and layer.
-    let estimated =
-        (3.0 * layers as f64 * master_area / (0.433 * limits.straight_m * limits.straight_m)) as usize;
+    let limits = EdgeLimits::new(&sizing, wall_m, master_area, slender_length(&master_points));
+    let layers = ((wall_m / limits.curved_m).round() as usize).max(1);
+    // Refined triangles ≥ area / (√3/4 · h_longest²); three tets per prism and layer.
+    let longest = limits.longest();
+    let estimated = (3.0 * layers as f64 * master_area / (0.433 * longest * longest)) as usize;
     if estimated > sizing.max_tets {
-        return Err(NotLayered::TooMany { estimated, in_plane_m: limits.straight_m });
+        return Err(NotLayered::TooMany { estimated, in_plane_m: longest });
     }
     let opposite = Bvh::new(opposite.iter().map(|&t| triangles[t].map(|v| vertices[v])).collect());
     let layering =
@@ -167,7 +167,7 @@ pub(crate) fn layered(
     let skin = Skin::from_triangles(vertices, triangles, master).coarsened(
         &limits,
         wall_m,
-        INPUT_COLLAPSE_SHARE * limits.straight_m,
+        INPUT_COLLAPSE_SHARE * limits.longest(),
     );
     let max_triangles = sizing.max_tets / (3 * layers) + 1;
     // Longer edges along straight walls first; where their prisms fold or

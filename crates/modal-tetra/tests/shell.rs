@@ -228,6 +228,37 @@ fn an_open_disc_given_a_sheet_thickness_rings_like_a_free_kirchhoff_plate() {
 }
 
 #[test]
+fn a_wide_plate_is_sized_by_its_modes_not_by_its_wall() {
+    // A 24 cm disc 1 mm thick: two walls along it would be 2 mm edges and
+    // 4× the elements its 64 lowest modes need; the flat-wall rule gives
+    // 12 edges per bending wavelength of the 64th mode instead.
+    let (radius, h) = (0.12, 0.001);
+    let options = TetOptions { sheet_thickness: Some(h), ..Default::default() };
+    let (mesh, report) = tetrahedralize(&disc(radius, 0.0, 12, 64, false), &options).unwrap();
+    let area = std::f64::consts::PI * radius * radius;
+    let wavelength = std::f64::consts::TAU / (4.0 * std::f64::consts::PI * 64.0 / area).sqrt();
+    let flat = wavelength / modal_tetra::FLAT_CELLS_PER_WAVELENGTH;
+    assert!(
+        report.cell_m > 0.9 * flat && report.cell_m <= flat * 1.000001,
+        "{} m against {flat} m",
+        report.cell_m
+    );
+    assert!(report.cell_m > 3.5 * h, "{report:?}");
+    let brass = Material::custom(1e11, 0.33, 8500.0, 0.0, 0.0).unwrap();
+    let (checked, _) = modal_mesh::check(mesh).unwrap();
+    let ours = frequencies_in(&checked, &brass, 5);
+    let d = 1e11 * h.powi(3) / (12.0 * (1.0 - 0.33f64.powi(2)));
+    let scale = (d / (8500.0 * h)).sqrt() / (std::f64::consts::TAU * radius * radius);
+    let want = [5.253, 5.253, 9.084, 12.23, 12.23].map(|l2| l2 * scale);
+    println!(
+        "24 cm disc, 1 mm: {} tets, edges up to {:.2} mm; ours {ours:.2?}, Kirchhoff {want:.2?}",
+        report.tets,
+        report.cell_m * 1e3
+    );
+    assert!(worst_rel(&ours, &want) < 0.015, "{ours:?} against {want:?}");
+}
+
+#[test]
 fn a_mug_with_a_handle_is_not_a_shell_and_is_stuffed() {
     // The handle's tube faces itself: its skins do not pair two by two.
     let surface = shapes::mug(0.04, 0.09, 0.004, 48);
