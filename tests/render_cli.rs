@@ -105,6 +105,10 @@ fn bad_scenes_name_the_field_and_write_nothing() {
             "nowhere.msh",
         ),
         (format!("{TWO_BLOCKS}\nsurprise = 1\n"), "surprise"),
+        (
+            TWO_BLOCKS.replacen("material = \"steel\"", "material = \"steel\"\nsheet_thickness = 0.002", 1),
+            "sheet_thickness",
+        ),
     ];
     for (k, (scene, needle)) in cases.iter().enumerate() {
         let name = format!("bad{k}.toml");
@@ -134,4 +138,38 @@ fn a_generated_shape_beyond_the_memory_guard_is_refused_before_it_is_generated()
     let args = ["render", "s.toml", "-o", "out/s.wav", "--radiation", "estimate"];
     modal_within_memory(dir.path(), &args, "0.05").ok();
     modal_within_memory(dir.path(), &args, "lots").fails_with("MODAL_MEMORY_LIMIT_GB");
+}
+
+#[test]
+fn a_sheet_without_thickness_sounds_when_the_scene_gives_it_one() {
+    // A 10 cm square modelled as one surface (as asset packs ship sheet metal):
+    // it encloses nothing, so the render stops with a clear error; with
+    // `sheet_thickness` it is a 2 mm steel plate that falls and rings.
+    let dir = temp_dir();
+    let square = "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n";
+    std::fs::write(dir.path().join("sheet.obj"), square).unwrap();
+    let scene = r#"
+duration = 0.4
+sample_rate = 16000
+[listener]
+position = [0.0, 0.2, 0.5]
+channels = "mono"
+radiation = "estimate"
+[ground]
+material = "wood"
+[[objects]]
+mesh = "sheet.obj"
+material = "steel"
+position = [0.0, 0.05, 0.0]
+rotation = { euler = [-80.0, 0.0, 0.0] }
+"#;
+    std::fs::write(dir.path().join("bare.toml"), scene).unwrap();
+    modal(dir.path(), &["render", "bare.toml", "-o", "bare.wav"]).fails_with("--sheet-thickness");
+    let thick = scene.replace("material = \"steel\"", "material = \"steel\"\nsheet_thickness = 0.002");
+    std::fs::write(dir.path().join("thick.toml"), thick).unwrap();
+    let report = modal(dir.path(), &["render", "thick.toml", "-o", "thick.wav", "--json"]).ok().json();
+    let object = &report["objects"][0];
+    assert!(object["impacts"].as_u64().unwrap() >= 1, "{object}");
+    assert!(object["modes_synthesized"].as_u64().unwrap() > 0, "{object}");
+    assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
 }

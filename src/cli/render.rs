@@ -331,6 +331,7 @@ impl PipelineProvider<'_> {
     fn request(&self, request: &BankRequest, material: Material, source: MeshSource) -> Request {
         let mut pipeline = Request::new(source, material);
         pipeline.scale = request.scale;
+        pipeline.surface.sheet_thickness = request.sheet_thickness;
         pipeline.order = request.order.unwrap_or(2);
         // No modes above the scene's Nyquist frequency are worth solving for.
         pipeline.max_freq_hz = request.max_frequency_hz;

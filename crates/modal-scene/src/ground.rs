@@ -38,6 +38,7 @@ pub(crate) fn with_slab(scene: &Scene) -> Cow<'_, Scene> {
         material: Some(g.material.clone()),
         order: None,
         scale: 1.0,
+        sheet_thickness: None,
         position_m: [g.center_m[0], g.height_m - 0.5 * t, g.center_m[1]],
         rotation: RotationSpec::default(),
         linear_velocity_m_s: [0.0; 3],

@@ -26,6 +26,8 @@ pub struct BankRequest {
     pub order: Option<u8>,
     /// Uniform geometric scale of the mesh.
     pub scale: f64,
+    /// Wall thickness [m] given to a surface mesh's open parts (`None`: none).
+    pub sheet_thickness: Option<f64>,
     /// Highest frequency worth solving for [Hz]: the scene's Nyquist frequency.
     pub max_frequency_hz: f64,
 }
@@ -40,6 +42,7 @@ impl BankRequest {
             material,
             order: object.order,
             scale: object.scale,
+            sheet_thickness: object.sheet_thickness,
             max_frequency_hz: 0.5 * scene.sample_rate_hz as f64,
         })
     }

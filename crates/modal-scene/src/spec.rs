@@ -390,6 +390,12 @@ pub struct ObjectSpec {
     /// Uniform scale applied to the mesh (default 1).
     #[serde(default = "defaults::one")]
     pub scale: f64,
+    /// Wall thickness [m] given to every open part of a surface mesh file (a
+    /// sheet modelled as one surface: a cymbal, a sign), as `modal precompute
+    /// --sheet-thickness`; `None` (default): open parts are filled as their
+    /// winding number encloses.
+    #[serde(default)]
+    pub sheet_thickness: Option<f64>,
     /// World position of the centre of mass [m].
     #[serde(rename = "position", default)]
     pub position_m: [f64; 3],

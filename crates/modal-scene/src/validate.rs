@@ -135,6 +135,15 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
         return Err(SceneError::invalid(key("order"), "must be 1 or 2"));
     }
     positive(&key("scale"), o.scale)?;
+    if let Some(t) = o.sheet_thickness {
+        positive(&key("sheet_thickness"), t)?;
+        if !matches!(&o.mesh, Some(MeshSource::File(_))) {
+            return Err(SceneError::invalid(
+                key("sheet_thickness"),
+                "applies to a `mesh` file (a surface mesh) only",
+            ));
+        }
+    }
     finite3(&key("position"), o.position_m)?;
     match &o.rotation {
         RotationSpec::AxisAngle { axis, angle } => {
