@@ -28,6 +28,7 @@ fn json_contract_cache_and_info_agree() {
     let run = modal(dir.path(), &args).ok();
     // In a log (stderr is not a terminal) the long stages are lines.
     assert!(run.stderr.contains("precompute: assembling K and M ("), "{}", run.stderr);
+    assert!(!run.stderr.contains("surface meshes only"), "{}", run.stderr);
     let first = run.json();
     for key in
         ["modes", "dofs", "order", "mass_kg", "rigid_modes_removed", "inertia_check", "cached", "timings_s"]
@@ -358,4 +359,20 @@ fn a_glb_or_off_without_a_modal_model_is_meshed_like_the_same_obj() {
     cube.triangles.iter().for_each(|t| off += &format!("3 {} {} {}\n", t[0], t[1], t[2]));
     std::fs::write(dir.path().join("box.off"), off).unwrap();
     assert_eq!(frequencies(&solve("box.off")), frequencies(&from_obj), "OFF: the same modes");
+}
+
+#[test]
+fn surface_options_on_a_tet_mesh_are_named_not_dropped() {
+    let dir = temp_dir();
+    let bar = example("bar_p1.msh");
+    let mut args = vec!["precompute", bar.to_str().unwrap(), "-o", "a.bank", "--modes", "4", "--no-cache"];
+    args.extend(STEEL);
+    args.extend(["--cell", "0.01", "--sheet-thickness", "0.002"]);
+    let run = modal(dir.path(), &args).ok();
+    assert!(
+        run.stderr.contains("--cell, --sheet-thickness apply to surface meshes only")
+            && run.stderr.contains("bar_p1.msh"),
+        "{}",
+        run.stderr
+    );
 }

@@ -194,7 +194,26 @@ pub(crate) fn load_mesh_sized(
             layered = tet_report.wall_layers > 0;
             mesh
         }
-        MeshSource::File(path) => modal_mesh::read_mesh(path, scale)?,
+        MeshSource::File(path) => {
+            // Surface meshing options do not apply to a tet mesh: say so rather than drop them.
+            let ignored: Vec<&str> = [
+                (surface.cell.is_some(), "--cell"),
+                (surface.part.is_some(), "--part"),
+                (surface.sheet_thickness.is_some(), "--sheet-thickness"),
+            ]
+            .into_iter()
+            .filter_map(|(given, name)| given.then_some(name))
+            .collect();
+            if !ignored.is_empty() {
+                warnings.push(format!(
+                    "{} appl{} to surface meshes only: {} is a tet mesh, used as it is",
+                    ignored.join(", "),
+                    if ignored.len() == 1 { "ies" } else { "y" },
+                    path.display()
+                ));
+            }
+            modal_mesh::read_mesh(path, scale)?
+        }
         MeshSource::Memory { mesh, .. } => {
             let mut mesh = mesh.clone();
             mesh.nodes.iter_mut().flatten().for_each(|x| *x *= scale);
