@@ -19,6 +19,7 @@ use std::collections::HashMap;
 
 use crate::diagnose::repair;
 use crate::geom::{add, area_vector, dot, norm, scale, V3};
+use crate::stuff::{edge, edge_triangles, EdgeTriangles};
 use crate::{TetraError, TriSurface};
 
 /// Largest mitre factor of an offset (a fold sharper than 120° gets no more).
@@ -92,20 +93,8 @@ pub(crate) fn thicken_open_sheets(
     Ok((out, report))
 }
 
-/// Triangles on each undirected edge `(min, max)`.
-fn edge_triangles(triangles: &[[usize; 3]]) -> HashMap<(usize, usize), Vec<usize>> {
-    let mut edges: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (u, v) = (tri[k], tri[(k + 1) % 3]);
-            edges.entry((u.min(v), u.max(v))).or_default().push(t);
-        }
-    }
-    edges
-}
-
 /// The edge-connected component of every triangle.
-fn components(triangles: &[[usize; 3]], edges: &HashMap<(usize, usize), Vec<usize>>) -> Vec<usize> {
+fn components(triangles: &[[usize; 3]], edges: &EdgeTriangles) -> Vec<usize> {
     let mut component = vec![usize::MAX; triangles.len()];
     let mut count = 0;
     for seed in 0..triangles.len() {
@@ -117,7 +106,7 @@ fn components(triangles: &[[usize; 3]], edges: &HashMap<(usize, usize), Vec<usiz
         while let Some(t) = stack.pop() {
             for k in 0..3 {
                 let (u, v) = (triangles[t][k], triangles[t][(k + 1) % 3]);
-                for &n in &edges[&(u.min(v), u.max(v))] {
+                for &n in &edges[&edge(u, v)] {
                     if component[n] == usize::MAX {
                         component[n] = count;
                         stack.push(n);
