@@ -74,6 +74,8 @@ pub(crate) struct Repaired {
     pub vertices: Vec<V3>,
     pub triangles: Vec<[usize; 3]>,
     pub report: SurfaceReport,
+    /// The components `triangles` fall into, joined across manifold edges only.
+    pub components: Vec<Component>,
 }
 
 /// Diagnoses `surface` (see the module doc). Never fails; an empty surface
@@ -106,11 +108,11 @@ pub(crate) fn repair(surface: &TriSurface) -> Repaired {
             triangles.push(t);
         }
     }
-    let flips = orient(&vertices, &mut triangles, &mut report);
+    let (flips, components) = orient(&vertices, &mut triangles, &mut report);
     report.flipped_faces = flips;
     report.warnings.extend(unit_warning(report.diagonal_m));
     report.warnings.extend(open_warning(report.open_boundary_edges));
-    Repaired { vertices, triangles, report }
+    Repaired { vertices, triangles, report, components }
 }
 
 /// Merges vertices on a grid of spacing `tol`; returns the welded vertices,
@@ -149,8 +151,12 @@ fn weld(surface: &TriSurface, tol: f64) -> (Vec<V3>, Vec<usize>, usize) {
 }
 
 /// Orients triangles consistently per component; returns how many were
-/// flipped. Fills the edge and component counts of `report`.
-fn orient(vertices: &[V3], triangles: &mut [[usize; 3]], report: &mut SurfaceReport) -> usize {
+/// flipped, and the components. Fills the edge and component counts of `report`.
+fn orient(
+    vertices: &[V3],
+    triangles: &mut [[usize; 3]],
+    report: &mut SurfaceReport,
+) -> (usize, Vec<Component>) {
     // (min vertex, max vertex, triangle, traversed min→max)
     let mut edges: Vec<(usize, usize, usize, bool)> = Vec::with_capacity(3 * triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
@@ -239,7 +245,7 @@ fn orient(vertices: &[V3], triangles: &mut [[usize; 3]], report: &mut SurfaceRep
             flipped += 1;
         }
     }
-    flipped
+    (flipped, components)
 }
 
 /// Says that closed parts inside others were kept solid, and how a cavity is marked.

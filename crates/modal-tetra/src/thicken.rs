@@ -19,7 +19,7 @@ use std::collections::HashMap;
 
 use crate::diagnose::repair;
 use crate::geom::{add, area_vector, dot, norm, scale, V3};
-use crate::stuff::{edge, edge_triangles, EdgeTriangles};
+use crate::stuff::edge_triangles;
 use crate::{TetraError, TriSurface};
 
 /// Largest mitre factor of an offset (a fold sharper than 120° gets no more).
@@ -49,8 +49,13 @@ pub(crate) fn thicken_open_sheets(
     let repaired = repair(surface);
     let (vertices, triangles) = (&repaired.vertices, &repaired.triangles);
     let edges = edge_triangles(triangles);
-    let component = components(triangles, &edges);
-    let mut open = vec![false; component.iter().max().map_or(0, |&c| c + 1)];
+    // Components joined across manifold edges only, so a closed part with a sheet
+    // fixed along one of its edges (three triangles there) stays closed.
+    let mut component = vec![0; triangles.len()];
+    for (c, part) in repaired.components.iter().enumerate() {
+        part.triangles.iter().for_each(|&t| component[t] = c);
+    }
+    let mut open = vec![false; repaired.components.len()];
     for tris in edges.values().filter(|t| t.len() == 1) {
         open[component[tris[0]]] = true;
     }
@@ -91,32 +96,6 @@ pub(crate) fn thicken_open_sheets(
     }
     out.parts.push(("surface".to_string(), 0..out.triangles.len()));
     Ok((out, report))
-}
-
-/// The edge-connected component of every triangle.
-fn components(triangles: &[[usize; 3]], edges: &EdgeTriangles) -> Vec<usize> {
-    let mut component = vec![usize::MAX; triangles.len()];
-    let mut count = 0;
-    for seed in 0..triangles.len() {
-        if component[seed] != usize::MAX {
-            continue;
-        }
-        component[seed] = count;
-        let mut stack = vec![seed];
-        while let Some(t) = stack.pop() {
-            for k in 0..3 {
-                let (u, v) = (triangles[t][k], triangles[t][(k + 1) % 3]);
-                for &n in &edges[&edge(u, v)] {
-                    if component[n] == usize::MAX {
-                        component[n] = count;
-                        stack.push(n);
-                    }
-                }
-            }
-        }
-        count += 1;
-    }
-    component
 }
 
 /// Edge `{u, v}` in the order triangle `tri` runs along it.
@@ -200,6 +179,25 @@ mod tests {
             "{}",
             diagnosis.enclosed_volume_m3
         );
+    }
+
+    #[test]
+    fn a_closed_part_with_a_fin_on_one_of_its_edges_is_kept() {
+        // A 0.1 m cube and a 0.1 m square fin standing up from its top front
+        // edge (three triangles on that edge). Joined across every edge they were
+        // one open part, and the cube was doubled into offset copies; now only
+        // the fin gets the wall: the cube's 12 triangles as they were, the fin's
+        // two faces (4) and a rim strip on its three free edges (6).
+        let mut s = crate::shapes::cuboid(0.1, 0.1, 0.1);
+        let shift = s.vertices.len();
+        let corner = |x: f64, z: f64| s.vertices.iter().position(|v| *v == [x, 0.1, z]).unwrap();
+        let (a, b) = (corner(0.0, 0.1), corner(0.1, 0.1));
+        s.vertices.extend([[0.0, 0.2, 0.1], [0.1, 0.2, 0.1]]);
+        s.triangles.extend([[a, b, shift + 1], [a, shift + 1, shift]]);
+        let (out, report) = thicken_open_sheets(&s, 0.01).unwrap();
+        assert_eq!(report.sheets, 1);
+        let cube_kept = (0..shift).all(|v| out.vertices[v] == s.vertices[v]);
+        assert!(cube_kept && out.triangles.len() == 12 + 4 + 2 * 3, "{} triangles", out.triangles.len());
     }
 
     #[test]
