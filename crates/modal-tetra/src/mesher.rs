@@ -320,6 +320,8 @@ pub fn tetrahedralize(
         None => None,
     };
     let sheets_thickened = thickened.as_ref().map_or(0, |(_, report)| report.sheets);
+    let slab_warning =
+        thickened.as_ref().zip(options.sheet_thickness).and_then(|((_, r), t)| r.slab_warning(t));
     let surface = thickened.as_ref().map_or(surface, |(thick, _)| thick);
     let repaired = repair(surface);
     if repaired.triangles.is_empty() {
@@ -336,7 +338,7 @@ pub fn tetrahedralize(
     let h0 = cell_size(options, diagonal, volume, area)?;
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
     let bvh = Bvh::new(tris);
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = slab_warning.into_iter().collect();
     let layered = try_layered(&repaired, &bvh, options, (diagonal, volume, area), &mut warnings)?;
     let (mut stuffed, h, thin_samples, min_thickness_m, wall_layers, smoothed) = match layered {
         Some(LayeredWall { mesh: l, smoothed }) => {

@@ -25,6 +25,10 @@ use crate::{TetraError, TriSurface};
 /// Largest mitre factor of an offset (a fold sharper than 120° gets no more).
 pub const MAX_MITRE: f64 = 2.0;
 
+/// A thickness above this share of the sheets' size (√ of their area) is
+/// warned about: likely a thickness in millimetres given as metres.
+pub const SLAB_SHARE: f64 = 0.25;
+
 /// What thickening did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Thickened {
@@ -32,6 +36,19 @@ pub(crate) struct Thickened {
     pub(crate) sheets: usize,
     /// Their area, one side [m²].
     pub(crate) sheet_area_m2: f64,
+}
+
+impl Thickened {
+    /// A warning when `thickness_m` is more than [`SLAB_SHARE`] of the sheets' size.
+    pub(crate) fn slab_warning(&self, thickness_m: f64) -> Option<String> {
+        let size = self.sheet_area_m2.sqrt();
+        (self.sheets > 0 && thickness_m > SLAB_SHARE * size).then(|| {
+            format!(
+                "the sheet thickness {thickness_m} m is more than a quarter of the open parts' size (√area = \
+                 {size:.3e} m): they became slabs; is the thickness in metres?"
+            )
+        })
+    }
 }
 
 /// `surface` with every open part a closed shell of `thickness_m` (module doc).
@@ -151,6 +168,9 @@ mod tests {
     fn a_square_sheet_becomes_a_closed_slab_of_the_thickness() {
         let (slab, report) = thicken_open_sheets(&square(), 0.1).unwrap();
         assert_eq!(report, Thickened { sheets: 1, sheet_area_m2: 1.0 });
+        assert_eq!(report.slab_warning(0.1), None);
+        // 2 given for 2 mm: a 1 m sheet 2 m thick is a slab, and the user is told.
+        assert!(report.slab_warning(2.0).is_some_and(|w| w.contains("in metres")));
         let diagnosis = crate::diagnose(&slab);
         assert_eq!(diagnosis.open_boundary_edges, 0, "{diagnosis:?}");
         assert!((diagnosis.enclosed_volume_m3 - 0.1).abs() < 1e-12, "{}", diagnosis.enclosed_volume_m3);
