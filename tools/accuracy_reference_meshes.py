@@ -15,6 +15,9 @@ ASSET: bracket | nonmanifold | soup | thin_shell. The geometry is the asset's ow
   geometry, reparametrized so it can be remeshed at SIZE); straight-sided TET10
   (their corners lie on the OBJ facets, so the geometry error vanishes with SIZE).
 Element size SIZE [m] (MeshSizeMax; MeshSizeMin = SIZE / 3), second order (10 nodes).
+--fine-box X0,Y0,Z0,X1,Y1,Z1 --fine-h H: elements of size H inside the box [m] (a Gmsh Box
+field, grading over one SIZE outside it), to converge a mode that lives in one region (the
+bell's crown plate) without refining the whole object.
 
 Environment used (2026-11-25): python3 -m venv /work/venvs/w14e-gmsh &&
 /work/venvs/w14e-gmsh/bin/pip install gmsh   (gmsh 4.15.2)
@@ -59,7 +62,11 @@ ap.add_argument("asset", choices=["bracket", "nonmanifold", "soup", "thin_shell"
 ap.add_argument("corpus")
 ap.add_argument("out")
 ap.add_argument("--h", type=float, required=True)
+ap.add_argument("--fine-box", type=lambda t: [float(x) for x in t.split(",")])
+ap.add_argument("--fine-h", type=float)
 a = ap.parse_args()
+if (a.fine_box is None) != (a.fine_h is None) or (a.fine_box is not None and len(a.fine_box) != 6):
+    ap.error("--fine-box X0,Y0,Z0,X1,Y1,Z1 and --fine-h H go together")
 
 obj = f"{a.corpus}/{a.asset}.obj"
 verts = obj_vertices(obj)
@@ -97,7 +104,15 @@ if a.asset == "thin_shell":
     gmsh.model.geo.addVolume([gmsh.model.geo.addSurfaceLoop(surfaces)])
     gmsh.model.geo.synchronize()
 gmsh.option.setNumber("Mesh.MeshSizeMax", a.h)
-gmsh.option.setNumber("Mesh.MeshSizeMin", a.h / 3)
+gmsh.option.setNumber("Mesh.MeshSizeMin", min(a.h, a.fine_h or a.h) / 3)
+if a.fine_box is not None:
+    box = gmsh.model.mesh.field.add("Box")
+    for name, value in zip(["XMin", "YMin", "ZMin", "XMax", "YMax", "ZMax"], a.fine_box):
+        gmsh.model.mesh.field.setNumber(box, name, value)
+    gmsh.model.mesh.field.setNumber(box, "VIn", a.fine_h)
+    gmsh.model.mesh.field.setNumber(box, "VOut", a.h)
+    gmsh.model.mesh.field.setNumber(box, "Thickness", a.h)
+    gmsh.model.mesh.field.setAsBackgroundMesh(box)
 gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
 if a.asset == "thin_shell":
     # Mid-edge nodes at the straight midpoints: curving them onto the reparametrized
@@ -111,4 +126,5 @@ gmsh.option.setNumber("Mesh.SaveAll", 0)
 gmsh.write(a.out)
 n = len(gmsh.model.mesh.getNodes()[0])
 gmsh.finalize()
-print(f"{a.asset}: h = {a.h} m, {n} nodes, {3 * n} DOF -> {a.out}")
+fine = f", {a.fine_h} m in {a.fine_box}" if a.fine_box else ""
+print(f"{a.asset}: h = {a.h} m{fine}, {n} nodes, {3 * n} DOF -> {a.out}")
