@@ -341,6 +341,11 @@ fn four_level_reference(levels: &[&modal_bank::ModeBank]) -> Vec<(f64, f64, Opti
 
 /// The error of `run`'s first modes against `reference` (matched by MAC to the finest
 /// reference level): (per-mode rows, worst error %, estimate failures).
+///
+/// The reference is known only to within its uncertainty `u`, so the measured error `e`
+/// is too: an estimate fails only where `e − u` exceeds it. Where the estimate lies within
+/// `e ± u` the row says `"judged": false` (the reference cannot tell) and it is no failure;
+/// a tighter reference is then what is missing, not a looser test.
 fn compare(
     name: &str,
     run: &modal_bank::ModeBank,
@@ -353,18 +358,31 @@ fn compare(
     for (i, &partner) in m.iter().enumerate().take(COMPARED_MODES) {
         let f = run.frequencies_hz[i];
         let Some(j) = partner else {
-            failures.push(format!("{name}: mode {} ({f:.1} Hz) not matched to the reference", i + 1));
+            let own = match run.info.error_estimate_pct.get(i).copied().flatten() {
+                Some(e) => format!("estimate {e:.3} %"),
+                None => "no estimate of its own either".to_string(),
+            };
+            failures.push(format!("{name}: mode {} ({f:.1} Hz) not matched to the reference ({own})", i + 1));
             continue;
         };
         let (f_ref, unc, p) = reference[j];
         let err = 100.0 * (f / f_ref - 1.0).abs();
+        let unc_pct = 100.0 * unc / f_ref;
         worst = worst.max(err);
         let est = run.info.error_estimate_pct.get(i).copied().flatten();
-        if !run.info.error_estimate_pct.is_empty() && est.is_none_or(|e| e < err) {
-            failures.push(format!("{name}: mode {} ({f:.1} Hz) error {err:.3} % > estimate {est:?}", i + 1));
+        let misses = est.is_none_or(|e| e < err);
+        // A reference without an uncertainty (NaN) cannot tell either.
+        let cannot_tell = misses && est.is_some_and(|e| unc_pct.is_nan() || err - unc_pct <= e);
+        let judged = !cannot_tell;
+        if !run.info.error_estimate_pct.is_empty() && misses && judged {
+            failures.push(format!(
+                "{name}: mode {} ({f:.1} Hz) error {err:.3} % ± {unc_pct:.3} % (reference) > estimate {est:?}",
+                i + 1
+            ));
         }
         rows.push(serde_json::json!({"mode": i + 1, "frequency_hz": f, "reference_hz": f_ref,
-            "reference_uncertainty_hz": unc, "reference_order": p, "error_pct": err, "error_estimate_pct": est}));
+            "reference_uncertainty_hz": unc, "reference_order": p, "error_pct": err, "error_estimate_pct": est,
+            "judged": judged}));
     }
     (rows, worst, failures)
 }
@@ -374,8 +392,10 @@ fn compare(
 /// meshes up to 200k DOF). First make the Gmsh meshes (needs Python with gmsh):
 /// `modal mesh corpus --out $D && for a in bracket nonmanifold; do for k in 1:0.008 2:0.005657 3:0.004;
 /// do python3 tools/accuracy_reference_meshes.py $a $D $D/${a}_g${k%:*}.msh --h ${k#*:}; done; done`
-/// (soup: sizes 0.012, 0.008485, 0.006; thin_shell: 0.008, 0.005657, 0.004; the bracket
-/// also `bracket_g4.msh` at 0.002828, 227k DOF, for its re-entrant edge), then
+/// (soup: sizes 0.012, 0.008485, 0.006; the bracket also `bracket_g4.msh` at 0.002828, 227k
+/// DOF, for its re-entrant edge; thin_shell: 0.008, 0.005657, 0.004, 0.002828, each with
+/// `--fine-box=-0.04,-0.04,0.112,0.04,0.04,0.13 --fine-h` half its size at the crown, whose
+/// 0.08 mm neck uniform levels do not converge on: 1.07M DOF and 14 GB at the finest), then
 /// `MODAL_ACCURACY_DIR=$D cargo test --test accuracy_cli -- --ignored real_assets --nocapture`
 /// (reference solves are cached in `$D/cache`). `MODAL_OLD_BINARY=PATH` runs the old-cell
 /// rows with a `modal` built before the graded mesher (its uniform mesher). Default and
@@ -437,6 +457,10 @@ fn real_assets_against_converged_references() {
                 }
             };
             let (rows, worst, mut bad) = compare(name, &run.bank, &finest.bank, &reference);
+            let unjudged = rows.iter().filter(|r| r["judged"] == false).count();
+            if unjudged > 0 {
+                println!("{name}: {label}: {unjudged} mode(s) miss their estimate by less than the reference's uncertainty (not judged)");
+            }
             if label == "default" {
                 failures.append(&mut bad);
             }

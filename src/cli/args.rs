@@ -172,6 +172,10 @@ pub enum MeshShape {
         /// Give every open part (a sheet modelled as one surface) this wall thickness [m].
         #[arg(long, value_name = "M")]
         sheet_thickness: Option<f64>,
+        /// Size flat walls (plates, cymbals) for a bank of N modes, as `precompute --modes N`
+        /// does: for the (N/2)-th mode, at least the 64th.
+        #[arg(long, value_name = "N", default_value_t = modal_tetra::FLAT_RESOLVED_MODES)]
+        modes: usize,
         /// Print a JSON report on stdout.
         #[arg(long)]
         json: bool,

@@ -20,14 +20,19 @@ pub fn run(shape: MeshShape) -> Result<()> {
         MeshShape::Sphere { radius, common } => generate(Shape::Sphere { radius }, common),
         MeshShape::Bowl { radius, thickness, common } => generate(Shape::Bowl { radius, thickness }, common),
         MeshShape::Corpus(args) => super::corpus::run(args),
-        MeshShape::Tet { input, out, cell, scale, part, sheet_thickness, json } => {
+        MeshShape::Tet { input, out, cell, scale, part, sheet_thickness, modes, json } => {
             let (surface, mut report) = modal_tetra::read_surface(&input, scale, part.as_deref())
                 .with_context(|| format!("cannot read surface mesh {}", input.display()))?;
             if sheet_thickness.is_some() {
                 report.drop_open_warning();
             }
             report.warnings.iter().for_each(|w| warn(w));
-            let options = modal_tetra::TetOptions { cell, sheet_thickness, ..Default::default() };
+            let options = modal_tetra::TetOptions {
+                cell,
+                sheet_thickness,
+                resolved_modes: modes,
+                ..Default::default()
+            };
             let (mesh, tet_report) = modal_tetra::tetrahedralize(&surface, &options)
                 .with_context(|| format!("cannot tetrahedralize {}", input.display()))?;
             write_mesh(&out, &mesh)?;

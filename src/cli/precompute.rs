@@ -20,8 +20,12 @@ fn request(mesh: &Path, material_args: &MaterialArgs, input: &MeshInputArgs) -> 
     let mut request = Request::new(MeshSource::File(mesh.to_path_buf()), material);
     request.scale = input.scale;
     request.order = input.order;
-    request.surface =
-        SurfaceMeshing { cell: input.cell, part: input.part.clone(), sheet_thickness: input.sheet_thickness };
+    request.surface = SurfaceMeshing {
+        cell: input.cell,
+        part: input.part.clone(),
+        sheet_thickness: input.sheet_thickness,
+        ..Default::default()
+    };
     Ok(request)
 }
 

@@ -346,8 +346,12 @@ impl Manifest {
         request.max_modes = o.modes.unwrap_or(request.max_modes);
         request.min_freq_hz = o.min_freq.unwrap_or(request.min_freq_hz);
         request.max_freq_hz = o.max_freq.unwrap_or(request.max_freq_hz);
-        request.surface =
-            SurfaceMeshing { cell: o.cell, part: o.part.clone(), sheet_thickness: o.sheet_thickness };
+        request.surface = SurfaceMeshing {
+            cell: o.cell,
+            part: o.part.clone(),
+            sheet_thickness: o.sheet_thickness,
+            ..Default::default()
+        };
         request.accuracy = match o.accuracy.unwrap_or(Accuracy::Target(AccuracyTarget::default().target_pct))
         {
             Accuracy::Target(target_pct) => Some(AccuracyTarget { target_pct, ..AccuracyTarget::default() }),

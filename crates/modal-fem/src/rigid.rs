@@ -8,36 +8,25 @@
 
 use faer::sparse::SparseColMat;
 use faer::Mat;
-use modal_mesh::TetMesh;
+use modal_mesh::{DisjointSets, TetMesh};
 
 /// Connected parts of `mesh`: `(part_of_node, part_count)`, two nodes being
 /// in one part when an element chain links them. Parts are numbered in order
 /// of their lowest node; a node in no element forms a part of its own.
 pub fn node_parts(mesh: &TetMesh) -> (Vec<usize>, usize) {
     let n = mesh.node_count();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    let mut sets = DisjointSets::new(n);
     for e in 0..mesh.cells.len() {
         let nodes = mesh.cells.nodes_of(e);
         for &other in &nodes[1..] {
-            // Both roots afresh: the previous union may have moved the first node's root.
-            let (a, b) = (root(&mut parent, nodes[0]), root(&mut parent, other));
-            if a != b {
-                parent[a.max(b)] = a.min(b);
-            }
+            sets.join(nodes[0], other);
         }
     }
     let mut part_of_root = vec![usize::MAX; n];
     let mut part = vec![0; n];
     let mut count = 0;
     for i in 0..n {
-        let r = root(&mut parent, i);
+        let r = sets.root(i);
         if part_of_root[r] == usize::MAX {
             part_of_root[r] = count;
             count += 1;

@@ -25,6 +25,7 @@
 //! file position, element or node; nothing here panics on user data.
 
 mod closest;
+mod disjoint;
 mod error;
 mod icosphere;
 mod measure;
@@ -40,6 +41,7 @@ pub mod generate;
 pub mod io;
 
 pub use closest::closest_point_on_triangle;
+pub use disjoint::DisjointSets;
 pub use error::{Location, MeshError};
 pub use icosphere::icosphere;
 pub use io::{read_mesh, write_msh41, write_msh41_file};

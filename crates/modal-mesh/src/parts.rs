@@ -16,7 +16,7 @@
 
 use std::collections::HashMap;
 
-use crate::{Cells, TetMesh};
+use crate::{Cells, DisjointSets, TetMesh};
 
 /// Parts of a mesh found through shared faces.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -53,14 +53,6 @@ impl Hinge {
     }
 }
 
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
-}
-
 /// Face-connected parts and the hinges between them. Node indices must be
 /// in range (as after [`crate::check`]); corner faces decide, so 4- and
 /// 10-node meshes are treated alike.
@@ -76,20 +68,17 @@ pub fn face_parts(mesh: &TetMesh) -> FaceParts {
         }
     }
     faces.sort_unstable();
-    let mut parent: Vec<usize> = (0..tets).collect();
+    let mut sets = DisjointSets::new(tets);
     for pair in faces.windows(2) {
         if pair[0].0 == pair[1].0 {
-            let (a, b) = (find(&mut parent, pair[0].1), find(&mut parent, pair[1].1));
-            if a != b {
-                parent[a.max(b)] = a.min(b);
-            }
+            sets.join(pair[0].1, pair[1].1);
         }
     }
     let mut id_of_root = vec![usize::MAX; tets];
     let mut sizes = Vec::new();
     let part_of_tet: Vec<usize> = (0..tets)
         .map(|e| {
-            let r = find(&mut parent, e);
+            let r = sets.root(e);
             if id_of_root[r] == usize::MAX {
                 id_of_root[r] = sizes.len();
                 sizes.push(0);

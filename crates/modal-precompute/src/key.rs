@@ -36,7 +36,7 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
         .add_f64("max_freq_hz", request.max_freq_hz)
         .add_u64("max_modes", request.max_modes as u64)
         .add_str("fix_box", &format!("{:?}", request.fix_box))
-        .add_str("mesher", &request.surface.tet_options().cache_key_fields())
+        .add_str("mesher", &request.surface_meshing().tet_options().cache_key_fields())
         .add_str("part", &format!("{:?}", request.surface.part));
     // The accuracy target chooses the discretization of a surface mesh (and adds the
     // estimate); a prescribed tet mesh is solved as it is. Absent: the key is unchanged.

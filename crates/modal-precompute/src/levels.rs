@@ -201,9 +201,11 @@ fn solve_level(
     })
 }
 
-/// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes.
+/// The request every level solves: the band widened by [`BAND_MARGIN`], a few more modes
+/// (the mesh still sized for the request's own modes).
 fn widened(request: &Request) -> Request {
     let mut wide = request.clone();
+    wide.surface = request.surface_meshing();
     wide.min_freq_hz = request.min_freq_hz / BAND_MARGIN;
     wide.max_freq_hz = request.max_freq_hz * BAND_MARGIN;
     wide.max_modes = request.max_modes + (request.max_modes / 4).max(6);
@@ -264,17 +266,19 @@ pub(crate) fn solve_to_accuracy(
         if worst.is_some_and(|w| w <= target.target_pct) {
             return Ok((bank, warnings, coarsened));
         }
-        let reached = describe_worst(worst, target);
+        let reached = describe_worst(target, &kept, &bank.frequencies_hz);
         // The size that would reach the target by the estimate's own model.
         let wanted = worst.map_or(MAX_STEP, |w| 0.9 * (target.target_pct / w).powf(1.0 / ASSUMED_ORDER));
         let step = wanted.clamp(MIN_STEP, MAX_STEP);
+        // The cell factor to advise: none for a mode without an estimate, about which the
+        // model says nothing.
+        let advised = worst.map(|_| wanted.min(MAX_STEP));
         if prescribed {
             let cell = request.surface.cell.unwrap_or_default();
-            warnings.push(format!(
-                "{reached} at the given --cell {cell:.4e} m; about --cell {:.4e} m would reach {} %",
-                cell * wanted.min(MAX_STEP),
-                target.target_pct
-            ));
+            let advice = advised.map_or(String::new(), |f| {
+                format!("; about --cell {:.4e} m would reach {} %", cell * f, target.target_pct)
+            });
+            warnings.push(format!("{reached} at the given --cell {cell:.4e} m{advice}"));
             return Ok((bank, warnings, coarsened));
         }
         let guard = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
@@ -289,8 +293,11 @@ pub(crate) fn solve_to_accuracy(
                 ),
                 Stop::Time { predicted_s } => format!(
                     "the next finer level (cell {cell:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
-                     time budget of {TIME_BUDGET_S:.0} s (about --cell {:.2e} m would reach the target)",
-                    fine.cell_m * wanted.min(MAX_STEP)
+                     time budget of {TIME_BUDGET_S:.0} s{}",
+                    advised.map_or(String::new(), |f| format!(
+                        " (about --cell {:.2e} m would reach the target)",
+                        fine.cell_m * f
+                    ))
                 ),
                 Stop::Refinements => format!("stopped after {MAX_REFINEMENTS} refinements"),
             };
@@ -377,17 +384,41 @@ impl NextLevel {
     }
 }
 
-fn describe_worst(worst: Option<f64>, target: &AccuracyTarget) -> String {
-    match worst {
-        Some(w) => format!(
+/// What the estimate reached, for the warning: the worst estimate of the lowest modes, or
+/// which of them (number and frequency `hz`) have no estimate.
+fn describe_worst(target: &AccuracyTarget, kept: &LevelEstimate, hz: &[f64]) -> String {
+    if let Some(w) = kept.worst_of_first(target.modes) {
+        return format!(
             "estimated error of the lowest {} modes up to {w:.2} % (target {} %)",
             target.modes, target.target_pct
-        ),
-        None => format!(
-            "some of the lowest {} modes could not be matched between levels, so their error is unknown (target {} %)",
-            target.modes, target.target_pct
-        ),
+        );
     }
+    let unmatched: Vec<String> = kept
+        .error_pct
+        .iter()
+        .zip(hz)
+        .take(target.modes)
+        .enumerate()
+        .filter(|(_, (e, _))| e.is_none())
+        .map(|(i, (_, f))| format!("{} ({f:.0} Hz)", i + 1))
+        .collect();
+    if unmatched.is_empty() {
+        return format!(
+            "the lowest {} modes have no error estimate (target {} %)",
+            target.modes, target.target_pct
+        );
+    }
+    // A mode the coarser level does not have lives in a feature that level cannot hold:
+    // the corpus bell's crown hangs on a 0.08 mm neck, and its two crown modes come out
+    // 13–17 % stiff at the defaults (BENCHMARKS.md, "The corpus bell's crown").
+    format!(
+        "mode(s) {} of the lowest {} have no mode like them on the coarser level, so their error is unknown \
+         (target {} %): a feature finer than the cells (a neck, a thin flap) may carry them, and a finer cell \
+         is no promise",
+        unmatched.join(", "),
+        target.modes,
+        target.target_pct
+    )
 }
 
 /// The modes of `bank` inside the request's band, at most `max_modes`, with their
@@ -434,6 +465,24 @@ mod tests {
     }
 
     #[test]
+    fn a_mode_without_an_estimate_is_named_and_given_no_cell_promise() {
+        let target = AccuracyTarget { target_pct: 1.0, modes: 3 };
+        let kept = LevelEstimate {
+            error_pct: vec![Some(0.2), None, Some(0.3), None],
+            matched: vec![Some(0), None, Some(1), None],
+            mac: vec![1.0, 0.0, 1.0, 0.0],
+            ratio: 1.5,
+        };
+        let hz = [637.1, 1484.4, 1685.3, 3075.8];
+        let said = describe_worst(&target, &kept, &hz);
+        assert!(said.starts_with("mode(s) 2 (1484 Hz) of the lowest 3"), "{said}");
+        assert!(!said.contains("3076"), "mode 4 is beyond the target's modes: {said}");
+        let all = LevelEstimate { error_pct: vec![Some(0.2), Some(0.3), Some(0.1), None], ..kept };
+        let worst = describe_worst(&target, &all, &hz);
+        assert!(worst.contains("up to 0.30 %"), "{worst}");
+    }
+
+    #[test]
     fn refinement_stops_for_memory_then_time_then_count() {
         // 1 GB and 2 s at step 0.5: the next level needs 16 GB and 128 s.
         let next = NextLevel { memory: 1_000_000_000, seconds: 2.0, spent: 3.0, step: 0.5 };
@@ -450,5 +499,20 @@ mod tests {
         // The time spent counts: 55 s already spent leaves no room for 7.6 s more.
         let late = NextLevel { spent: 55.0, ..cheap };
         assert!(matches!(late.refused(0, None), Some(Stop::Time { .. })));
+    }
+
+    #[test]
+    fn every_level_meshes_a_plate_for_the_requested_modes_not_the_widened_count() {
+        let mut request =
+            Request::new(MeshSource::File("plate.obj".into()), modal_fem::Material::preset("steel").unwrap());
+        request.max_modes = 200;
+        let wide = widened(&request);
+        assert!(wide.max_modes > 200);
+        assert_eq!(wide.surface_meshing().tet_options().resolved_modes, 200);
+        assert_eq!(request.surface_meshing().tet_options().resolved_modes, 200);
+        // The default 64 modes: the mesher's default options, so the default mesh and key.
+        let default =
+            Request::new(MeshSource::File("plate.obj".into()), modal_fem::Material::preset("steel").unwrap());
+        assert_eq!(widened(&default).surface_meshing().tet_options(), modal_tetra::TetOptions::default());
     }
 }

@@ -31,15 +31,21 @@ pub struct SurfaceMeshing {
     /// Wall thickness [m] given to open parts (sheets modelled as one
     /// surface): `modal_tetra::TetOptions::sheet_thickness`.
     pub sheet_thickness: Option<f64>,
+    /// Flat walls are sized to resolve this many modes
+    /// (`modal_tetra::TetOptions::resolved_modes`); `None`: the mesher's
+    /// default, or, through a [`crate::Request`], its mode count.
+    pub resolved_modes: Option<usize>,
 }
 
 impl SurfaceMeshing {
     /// The mesher options these settings stand for.
     pub fn tet_options(&self) -> modal_tetra::TetOptions {
+        let defaults = modal_tetra::TetOptions::default();
         modal_tetra::TetOptions {
             cell: self.cell,
             sheet_thickness: self.sheet_thickness,
-            ..Default::default()
+            resolved_modes: self.resolved_modes.unwrap_or(defaults.resolved_modes),
+            ..defaults
         }
     }
 }

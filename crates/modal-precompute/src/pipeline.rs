@@ -67,6 +67,16 @@ impl Request {
         }
     }
 
+    /// The surface options with flat walls sized for the modes this request keeps
+    /// (unless they say otherwise): a plate asked for 200 modes is meshed finer than
+    /// one asked for the default 64 (`modal_tetra::TetOptions::resolved_modes`).
+    pub fn surface_meshing(&self) -> SurfaceMeshing {
+        SurfaceMeshing {
+            resolved_modes: self.surface.resolved_modes.or(Some(self.max_modes)),
+            ..self.surface.clone()
+        }
+    }
+
     fn validate(&self) -> Result<(), PrecomputeError> {
         let invalid = |msg: String| Err(PrecomputeError::Invalid(msg));
         if !matches!(self.order, 1 | 2) {
@@ -186,7 +196,7 @@ pub(crate) fn assemble_and_analyze(
     let budget = limit
         .filter(|_| request.order == 2)
         .map(|limit_bytes| TetBudget { limit_bytes, vector_bytes_per_dof });
-    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface, level, budget)?;
+    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface_meshing(), level, budget)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);

@@ -2,7 +2,8 @@
 //!
 //! Steps: weld vertices closer than 1e-10 × the bounding-box diagonal (count
 //! duplicates), drop triangles that collapse to zero area (count degenerates),
-//! classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
+//! split edges at T-junctions (module `tjunction`), drop faces written twice
+//! (module `coincident`), classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
 //! or more), then orient triangles consistently across manifold edges per
 //! connected component (breadth-first) and flip a component whose signed
 //! volume is negative, except the inner walls of hollow objects, which keep
@@ -11,8 +12,10 @@
 
 use std::collections::HashMap;
 
+use crate::coincident::{drop_coincident, Coincident, Sheets};
 use crate::geom::{cross, dot, norm, sub, V3};
 use crate::nesting::{nest, Component};
+use crate::tjunction::split_t_junctions;
 use crate::TriSurface;
 
 /// What was wrong with an input surface (all counts refer to the input).
@@ -34,6 +37,21 @@ pub struct SurfaceReport {
     pub duplicate_vertices: usize,
     /// Triangles of zero area (or repeated corners) that were ignored.
     pub degenerate_triangles: usize,
+    /// Corners of one triangle found on an open edge of another (a
+    /// T-junction), where that edge was split so the seam closes.
+    pub t_junctions: usize,
+    /// Triangles that repeat another with the same winding (a duplicated
+    /// export), ignored.
+    pub repeated_triangles: usize,
+    /// Faces written once for each side (a double-sided export): one
+    /// triangle of each such pair was ignored.
+    pub double_sided_faces: usize,
+    /// Faces of open sheets written once for each side: a sheet without
+    /// thickness encloses nothing, so both sides were ignored.
+    pub double_sided_sheet_faces: usize,
+    /// Triangles where two parts touch face to face (opposite pairs), both
+    /// ignored: the parts are meshed as one body.
+    pub touching_triangles: usize,
     /// Edges used by exactly one triangle (holes, open sheets).
     pub open_boundary_edges: usize,
     /// Edges used by three or more triangles.
@@ -61,6 +79,11 @@ impl SurfaceReport {
     pub fn is_clean(&self) -> bool {
         self.duplicate_vertices == 0
             && self.degenerate_triangles == 0
+            && self.t_junctions == 0
+            && self.repeated_triangles == 0
+            && self.double_sided_faces == 0
+            && self.double_sided_sheet_faces == 0
+            && self.touching_triangles == 0
             && self.open_boundary_edges == 0
             && self.non_manifold_edges == 0
             && self.inconsistent_edges == 0
@@ -84,7 +107,19 @@ pub fn diagnose(surface: &TriSurface) -> SurfaceReport {
     repair(surface).report
 }
 
+/// Welds, cleans and orients `surface` (module doc). A double-sided open
+/// sheet is dropped: it encloses nothing.
 pub(crate) fn repair(surface: &TriSurface) -> Repaired {
+    repair_with(surface, Sheets::Drop)
+}
+
+/// As [`repair`], but a double-sided open sheet keeps one side: for a
+/// caller that gives open sheets a thickness.
+pub(crate) fn repair_keeping_sheets(surface: &TriSurface) -> Repaired {
+    repair_with(surface, Sheets::Keep)
+}
+
+fn repair_with(surface: &TriSurface, sheets: Sheets) -> Repaired {
     let mut report = SurfaceReport {
         triangles: surface.triangles.len(),
         vertices: surface.vertices.len(),
@@ -108,9 +143,18 @@ pub(crate) fn repair(surface: &TriSurface) -> Repaired {
             triangles.push(t);
         }
     }
+    let mut vertices = vertices;
+    report.t_junctions = split_t_junctions(&mut vertices, &mut triangles, report.diagonal_m);
+    let coincident = drop_coincident(&mut triangles, sheets);
+    report.repeated_triangles = coincident.repeated;
+    report.double_sided_faces = coincident.double_sided;
+    report.double_sided_sheet_faces = coincident.double_sided_sheet;
+    report.touching_triangles = coincident.touching;
     let (flips, components) = orient(&vertices, &mut triangles, &mut report);
     report.flipped_faces = flips;
     report.warnings.extend(unit_warning(report.diagonal_m));
+    report.warnings.extend(coincident_warning(&coincident));
+    report.warnings.extend(sheet_sides_warning(coincident.double_sided_sheet));
     report.warnings.extend(open_warning(report.open_boundary_edges));
     Repaired { vertices, triangles, report, components }
 }
@@ -276,7 +320,33 @@ fn signed_volume(vertices: &[V3], triangles: &[[usize; 3]], component: &[usize],
         .sum()
 }
 
-/// A warning when the size suggests the file is not in metres.
+/// Says which faces were written twice and were meshed once. Touching
+/// parts are not mentioned: they were one body before as well.
+fn coincident_warning(c: &Coincident) -> Option<String> {
+    let mut said = Vec::new();
+    if c.double_sided > 0 {
+        said.push(format!(
+            "{} face(s) are written once for each side (a double-sided export)",
+            c.double_sided
+        ));
+    }
+    if c.repeated > 0 {
+        said.push(format!("{} triangle(s) repeat another (a duplicated export)", c.repeated));
+    }
+    (!said.is_empty()).then(|| format!("{}: each face is meshed once", said.join("; ")))
+}
+
+/// Says that a double-sided open sheet was left out, and how to keep it.
+fn sheet_sides_warning(faces: usize) -> Option<String> {
+    (faces > 0).then(|| {
+        format!(
+            "{faces} face(s) of an open sheet are written once for each side (a double-sided export): a sheet \
+             without thickness encloses nothing, so they are left out; give it a thickness (--sheet-thickness M) \
+             to mesh it"
+        )
+    })
+}
+
 /// An open surface (holes, a sheet without thickness) is meshed as the
 /// solid its winding number encloses: a hole is capped, an open shell is
 /// filled. Said, because that may not be the object the user meant (an
@@ -292,15 +362,19 @@ fn open_warning(open_edges: usize) -> Option<String> {
 }
 
 impl SurfaceReport {
-    /// Removes the open-surface warning: for a caller that gives open parts a
-    /// thickness (`TetOptions::sheet_thickness`), where it does not hold.
+    /// Removes the warnings about open sheets (the open surface, a
+    /// double-sided sheet left out): for a caller that gives open parts a
+    /// thickness (`TetOptions::sheet_thickness`), where they do not hold.
     pub fn drop_open_warning(&mut self) {
-        if let Some(w) = open_warning(self.open_boundary_edges) {
+        let sheet_warnings =
+            [open_warning(self.open_boundary_edges), sheet_sides_warning(self.double_sided_sheet_faces)];
+        for w in sheet_warnings.into_iter().flatten() {
             self.warnings.retain(|x| *x != w);
         }
     }
 }
 
+/// A warning when the size suggests the file is not in metres.
 fn unit_warning(diagonal: f64) -> Option<String> {
     if diagonal > 20.0 {
         Some(format!(

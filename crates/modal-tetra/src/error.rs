@@ -85,6 +85,13 @@ pub enum TetraError {
         /// The configured limit.
         limit: usize,
     },
+    /// The repair left out every triangle (all of zero area, or all of
+    /// double-sided open sheets).
+    #[error("no triangle is left to mesh: {reason}")]
+    NothingLeft {
+        /// Why, and what to do.
+        reason: String,
+    },
     /// The surface encloses no volume at the chosen resolution.
     #[error("no tets at cell size {cell_m:.3e} m: {hint}")]
     NoVolume {

@@ -37,8 +37,9 @@
 //! [`LAYERED_STRAIGHT_CELL_PER_WALL`] along directions in which the wall of
 //! a slender shell, curved across them, is straight (a chime's axis), and
 //! where the wall is flat (a plate, a cymbal) up to
-//! [`FLAT_CELLS_PER_WAVELENGTH`] edges per bending wavelength of the
-//! [`FLAT_RESOLVED_MODES`]-th mode when that is longer; a solid that is no
+//! [`FLAT_CELLS_PER_WAVELENGTH`] edges per bending wavelength of the mode
+//! half-way up the bank ([`TetOptions::resolved_modes`]; at least the
+//! [`FLAT_RESOLVED_MODES`]-th) when that is longer; a solid that is no
 //! shell (a handle, a thick foot) is stuffed as before. Open parts given
 //! [`TetOptions::sheet_thickness`] become such shells first (module `thicken`).
 //!
@@ -59,6 +60,7 @@
 
 mod bvh;
 mod coarsen;
+mod coincident;
 pub mod corpus;
 mod curve;
 mod diagnose;
@@ -71,6 +73,7 @@ mod mesher;
 mod nesting;
 mod pairing;
 mod read;
+mod rescue;
 mod second_try;
 pub mod shapes;
 mod shell;
@@ -79,6 +82,7 @@ mod smooth;
 mod stuff;
 mod surface;
 mod thicken;
+mod tjunction;
 mod wall_rule;
 
 pub use curve::{MAX_BULGE, MIN_JACOBIAN_RATIO};

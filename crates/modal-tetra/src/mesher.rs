@@ -1,7 +1,7 @@
 //! The tetrahedralizer: options, report and the pipeline
 //! repair → winding-number BVH → BCC lattice → isosurface stuffing → checks.
 
-use modal_mesh::{Cells, TetMesh};
+use modal_mesh::{Cells, DisjointSets, TetMesh};
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
@@ -12,6 +12,7 @@ use crate::features::{features, snap};
 use crate::geom::{area_vector, dihedral_angles_deg, norm, orient6, V3};
 use crate::graded::MAX_LEVELS;
 use crate::lattice::Lattice;
+use crate::rescue::{clear, lost, mesh_alone, parts, triangles_outside};
 use crate::second_try::Smoothed;
 use crate::shell::{layered, LayerSizing, Layered, NotLayered};
 use crate::sizing::{surface_gap, Sizing};
@@ -92,6 +93,12 @@ pub struct TetOptions {
     /// cymbal, a sign) becomes a closed shell (module `thicken`). `None`
     /// (default): open parts are filled as their winding number encloses.
     pub sheet_thickness: Option<f64>,
+    /// The modes the bank keeps: a flat layered wall (a plate, a cymbal) gets
+    /// edges of a twelfth of the bending wavelength of the half of them
+    /// (module `wall_rule`); below twice [`crate::FLAT_RESOLVED_MODES`] the
+    /// plate is sized for that many (default), so only a bank of more than 128
+    /// modes gets a finer plate.
+    pub resolved_modes: usize,
 }
 
 impl Default for TetOptions {
@@ -108,6 +115,7 @@ impl Default for TetOptions {
             default_max_tets: DEFAULT_MAX_TETS,
             size_factor: 1.0,
             sheet_thickness: None,
+            resolved_modes: crate::FLAT_RESOLVED_MODES,
         }
     }
 }
@@ -116,8 +124,17 @@ impl TetOptions {
     /// The fields that change the output mesh, as `key=value` pairs joined by
     /// `;`, plus the algorithm version; meant for the pipeline's cache key.
     pub fn cache_key_fields(&self) -> String {
+        // Fields added later appear only when set, so older keys stay valid.
+        let sheet = self.sheet_thickness.map(|t| format!(";sheet_thickness={t}")).unwrap_or_default();
+        // Only the mode that sizes a flat wall changes the mesh.
+        let sized = crate::wall_rule::flat_sized_mode(self.resolved_modes);
+        let modes = if sized > crate::FLAT_RESOLVED_MODES {
+            format!(";flat_sized_mode={sized}")
+        } else {
+            String::new()
+        };
         format!(
-            "tetra=stuffing-v11;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
+            "tetra=stuffing-v13;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
             self.cell,
             self.target_tets,
             self.cells_per_diagonal,
@@ -127,7 +144,8 @@ impl TetOptions {
             self.graded,
             self.default_max_tets,
             self.size_factor
-        ) + &self.sheet_thickness.map(|t| format!(";sheet_thickness={t}")).unwrap_or_default()
+        ) + &sheet
+            + &modes
     }
 }
 
@@ -218,25 +236,17 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     };
     let parts = modal_mesh::face_parts(&mesh);
     let Cells::Tet4(tets) = mesh.cells else { unreachable!("built as Tet4 above") };
-    let (mut nodes, mut tets) = (mesh.nodes, tets);
-    let limit = HINGED_DROP_FRACTION * tets.len() as f64;
+    (stuffed.nodes, stuffed.tets) = (mesh.nodes, tets);
+    let limit = HINGED_DROP_FRACTION * stuffed.tets.len() as f64;
     // Clusters of pieces linked by hinges (chains included): each keeps its
     // largest piece; the others that are small are dropped.
-    let mut cluster: Vec<usize> = (0..parts.count).collect();
-    fn root(c: &mut [usize], mut x: usize) -> usize {
-        while c[x] != x {
-            c[x] = c[c[x]];
-            x = c[x];
-        }
-        x
-    }
+    let mut cluster = DisjointSets::new(parts.count);
     for h in &parts.hinges {
-        let (a, b) = (root(&mut cluster, h.parts[0]), root(&mut cluster, h.parts[1]));
-        cluster[a.max(b)] = a.min(b);
+        cluster.join(h.parts[0], h.parts[1]);
     }
     let mut largest = vec![usize::MAX; parts.count];
     for p in 0..parts.count {
-        let r = root(&mut cluster, p);
+        let r = cluster.root(p);
         if largest[r] == usize::MAX || parts.tets[p] > parts.tets[largest[r]] {
             largest[r] = p;
         }
@@ -245,7 +255,7 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     let mut places = Vec::new();
     for h in &parts.hinges {
         for p in h.parts {
-            let r = root(&mut cluster, p);
+            let r = cluster.root(p);
             if p != largest[r] && parts.tets[p] as f64 <= limit && !drop[p] {
                 drop[p] = true;
                 places.push(h.at);
@@ -256,27 +266,11 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
     let mut warnings = Vec::new();
     let mut dropped = 0;
     if pieces > 0 {
-        let kept: Vec<[usize; 4]> =
-            tets.iter().zip(&parts.part_of_tet).filter(|(_, &p)| !drop[p]).map(|(t, _)| *t).collect();
-        dropped = tets.len() - kept.len();
-        let mut index = vec![usize::MAX; nodes.len()];
-        let mut next = 0;
-        for t in &kept {
-            for &v in t {
-                if index[v] == usize::MAX {
-                    index[v] = next;
-                    next += 1;
-                }
-            }
-        }
-        let mut compact = vec![[0.0; 3]; next];
-        for (v, &i) in index.iter().enumerate() {
-            if i != usize::MAX {
-                compact[i] = nodes[v];
-            }
-        }
-        nodes = compact;
-        tets = kept.into_iter().map(|t| t.map(|v| index[v])).collect();
+        let mut tet = 0;
+        dropped = stuffed.retain_tets(|_| {
+            tet += 1;
+            !drop[parts.part_of_tet[tet - 1]]
+        });
         let p = places[0];
         warnings.push(format!(
             "dropped {pieces} small piece(s) of the tet mesh ({dropped} tets) that hung on the rest by an edge or a \
@@ -286,7 +280,11 @@ fn drop_hinged(stuffed: &mut crate::stuff::Stuffed) -> HingedDrop {
         ));
     }
     // Larger hinged pieces become separate bodies: each gets its own nodes.
-    let mut mesh = TetMesh { nodes, cells: Cells::Tet4(tets), groups: Vec::new() };
+    let mut mesh = TetMesh {
+        nodes: std::mem::take(&mut stuffed.nodes),
+        cells: Cells::Tet4(std::mem::take(&mut stuffed.tets)),
+        groups: Vec::new(),
+    };
     let parts = modal_mesh::face_parts(&mesh);
     let mut split = 0;
     if !parts.hinges.is_empty() {
@@ -325,7 +323,13 @@ pub fn tetrahedralize(
     let surface = thickened.as_ref().map_or(surface, |(thick, _)| thick);
     let repaired = repair(surface);
     if repaired.triangles.is_empty() {
-        return Err(TetraError::Empty);
+        let reason = if repaired.report.double_sided_sheet_faces > 0 {
+            "the surface is an open sheet written once for each side (a double-sided export), which encloses \
+             nothing: give it a thickness (--sheet-thickness M)"
+        } else {
+            "every triangle has zero area"
+        };
+        return Err(TetraError::NothingLeft { reason: reason.into() });
     }
     let (lo, hi) = surface.bounding_box().ok_or(TetraError::Empty)?;
     let diagonal = repaired.report.diagonal_m;
@@ -354,6 +358,11 @@ pub fn tetrahedralize(
     // A smoothed surface is the one the curved boundary follows; the
     // deviations reported stay against the input.
     let follow = smoothed.as_ref().unwrap_or(&bvh);
+    // Separate parts far thinner than this cell got slivers or nothing: they
+    // are meshed alone below (module `rescue`); the gap is measured on the rest.
+    let all_parts = parts(&repaired, 1e-6 * diagonal);
+    let lost_parts = lost(&all_parts, &repaired, &stuffed, diagonal);
+    clear(&mut stuffed, &lost_parts, diagonal);
     let hinged = drop_hinged(&mut stuffed);
     let boundary = boundary_nodes(&stuffed.tets);
     // A layered wall's nodes are on its skins already; snapping within a
@@ -364,16 +373,17 @@ pub fn tetrahedralize(
     } else {
         0
     };
-    let (min_dihedral_deg, max_dihedral_deg, mut volume_m3) = quality(&stuffed.nodes, &stuffed.tets);
+    let (mut min_dihedral_deg, mut max_dihedral_deg, mut volume_m3) = quality(&stuffed.nodes, &stuffed.tets);
     let mut max_surface_deviation_m = deviation(&stuffed.nodes, &boundary, &bvh);
     let mesh_boundary =
         Bvh::new(boundary_faces(&stuffed.tets).into_iter().map(|f| f.map(|v| stuffed.nodes[v])).collect());
+    let kept_triangles = triangles_outside(&repaired, &lost_parts);
     let (max_surface_gap_m, gap_at) =
-        surface_gap(&repaired.vertices, &repaired.triangles, &bvh, &mesh_boundary, 0.5 * h0);
+        surface_gap(&repaired.vertices, &kept_triangles, &bvh, &mesh_boundary, 0.5 * h0);
     if max_surface_gap_m > GAP_WARNING * diagonal {
         warnings.push(format!(
             "the mesh misses part of the surface by up to {max_surface_gap_m:.3e} m ({:.1} % of the diagonal) near \
-             ({:.4}, {:.4}, {:.4}) m: a part there is thinner than the cells (a smaller --cell keeps it)",
+             ({:.4}, {:.4}, {:.4}) m: a part there is thinner or smaller than the cells (a smaller --cell keeps it)",
             100.0 * max_surface_gap_m / diagonal,
             gap_at[0],
             gap_at[1],
@@ -389,6 +399,13 @@ pub fn tetrahedralize(
     } else {
         (TetMesh { nodes: stuffed.nodes, cells: Cells::Tet4(stuffed.tets), groups: Vec::new() }, 0, 0)
     };
+    let mut mesh = mesh;
+    for r in mesh_alone(&mut mesh, &lost_parts, &repaired, options, h, &mut warnings) {
+        volume_m3 += r.volume_m3;
+        max_surface_deviation_m = max_surface_deviation_m.max(r.max_surface_deviation_m);
+        min_dihedral_deg = min_dihedral_deg.min(r.min_dihedral_deg);
+        max_dihedral_deg = max_dihedral_deg.max(r.max_dihedral_deg);
+    }
     let report = TetReport {
         tets: mesh.cells.len(),
         nodes: mesh.nodes.len(),
@@ -456,6 +473,7 @@ fn try_layered(
         size_factor: options.size_factor,
         max_in_plane_m: size,
         max_tets: options.max_tets,
+        resolved_modes: options.resolved_modes,
     };
     let volume_m3 = repaired.report.enclosed_volume_m3;
     // A hollow body's outer and inner walls are two components of one body.

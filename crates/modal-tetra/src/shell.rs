@@ -60,8 +60,12 @@ pub const MIN_VOLUME_RATIO: f64 = 0.05;
 /// Largest relative difference between the mesh volume and the enclosed one.
 pub const VOLUME_TOLERANCE: f64 = 0.05;
 
-/// Refinement passes of the master skin (each at least halves the longest edge).
-const MAX_PASSES: usize = 12;
+/// Refinement passes of the master skin: a guard, never reached (a pass
+/// bisects every too-long triangle's longest edge, so two passes halve the
+/// longest edge, and the triangle budget stops the loop long before). It was
+/// 12, which silently left a plate exported as two triangles a face with
+/// edges of 1/64 of its diagonal, whatever the wall rule asked.
+const MAX_PASSES: usize = 64;
 
 /// A finely tessellated master skin is coarsened to the wall rule's size
 /// first (module `coarsen`), its new triangles and edges within this many
@@ -133,6 +137,8 @@ pub(crate) struct LayerSizing {
     pub max_in_plane_m: f64,
     /// Refuse (as [`NotLayered::TooMany`]) beyond this many tets.
     pub max_tets: usize,
+    /// The modes the bank keeps, which size flat walls (`TetOptions::resolved_modes`).
+    pub resolved_modes: usize,
 }
 
 /// Meshes the closed, outward-oriented surface (`vertices`, `triangles`,
@@ -351,7 +357,7 @@ impl Skin {
                 return Err(self.triangles.len());
             }
         }
-        Ok(())
+        Err(self.triangles.len())
     }
 
     /// Per vertex, the largest normal curvature `|Δn·Δx|/L²` of its edges

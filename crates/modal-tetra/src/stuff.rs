@@ -38,6 +38,7 @@ const BISECTIONS: usize = 30;
 const SLIVER_DEG: f64 = 10.0;
 
 /// Result of stuffing: nodes and positively oriented tets.
+#[derive(Clone, Debug)]
 pub(crate) struct Stuffed {
     pub nodes: Vec<V3>,
     pub tets: Vec<[usize; 4]>,
@@ -45,6 +46,28 @@ pub(crate) struct Stuffed {
     pub dropped: usize,
     /// Shortest background edge (m).
     pub min_cell: f64,
+}
+
+impl Stuffed {
+    /// Keeps the tets `keep` accepts and the nodes they use (renumbered in
+    /// order of first use); returns how many tets were removed.
+    pub fn retain_tets(&mut self, mut keep: impl FnMut(&[usize; 4]) -> bool) -> usize {
+        let before = self.tets.len();
+        self.tets.retain(|t| keep(t));
+        let mut index = vec![usize::MAX; self.nodes.len()];
+        let mut nodes = Vec::new();
+        for t in &mut self.tets {
+            for v in t.iter_mut() {
+                if index[*v] == usize::MAX {
+                    index[*v] = nodes.len();
+                    nodes.push(self.nodes[*v]);
+                }
+                *v = index[*v];
+            }
+        }
+        self.nodes = nodes;
+        before - self.tets.len()
+    }
 }
 
 type Edge = (usize, usize);

@@ -17,7 +17,7 @@
 
 use std::collections::HashMap;
 
-use crate::diagnose::repair;
+use crate::diagnose::repair_keeping_sheets;
 use crate::geom::{add, area_vector, dot, norm, scale, V3};
 use crate::stuff::edge_triangles;
 use crate::{TetraError, TriSurface};
@@ -63,7 +63,7 @@ pub(crate) fn thicken_open_sheets(
         });
     }
     // Welded, degenerate triangles dropped, each component oriented consistently.
-    let repaired = repair(surface);
+    let repaired = repair_keeping_sheets(surface);
     let (vertices, triangles) = (&repaired.vertices, &repaired.triangles);
     let edges = edge_triangles(triangles);
     // Components joined across manifold edges only, so a closed part with a sheet

@@ -40,6 +40,17 @@ fn stl_binary(s: &TriSurface) -> Vec<u8> {
     out
 }
 
+/// A binary STL whose free-form header begins with "solid", as SolidWorks
+/// and other CAD exporters write it: not ASCII for all that. The line break
+/// makes its first line read as text (a corner coordinate whose first byte
+/// is 0x0A, 0.04 as f32, does the same in real files).
+fn stl_binary_solid_header(s: &TriSurface) -> Vec<u8> {
+    let mut out = stl_binary(s);
+    let header = b"solid Part1 exported as binary\n";
+    out[..header.len()].copy_from_slice(header);
+    out
+}
+
 fn ply_ascii(s: &TriSurface) -> Vec<u8> {
     let mut out = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
@@ -100,6 +111,7 @@ fn all_formats_read_the_same_sphere() {
         (obj_bytes(&sphere), SurfaceFormat::Obj),
         (stl_ascii(&sphere), SurfaceFormat::Stl),
         (stl_binary(&sphere), SurfaceFormat::Stl),
+        (stl_binary_solid_header(&sphere), SurfaceFormat::Stl),
         (ply_ascii(&sphere), SurfaceFormat::Ply),
         (ply_binary(&sphere), SurfaceFormat::Ply),
         (off_modelnet(&sphere), SurfaceFormat::Off),
@@ -326,4 +338,51 @@ fn hostile_glb_gives_typed_errors() {
     let message = parse_err(&compressed);
     assert!(message.contains("decompress"), "{message}");
     parse_err(&glb(&sphere, r#"[{"mesh":0,"children":[1]},{"children":[0]}]"#, "[0]"));
+}
+
+/// An L-shaped prism whose two caps are single hexagons, as Blender's OBJ
+/// export writes n-gons; each cap listed from a corner that does not see the
+/// whole L, so a fan from it would cover the notch. The same prism in OBJ,
+/// PLY and OFF reads as a clean closed surface of the L's volume.
+#[test]
+fn concave_polygons_are_triangulated_inside_their_outline() {
+    let l = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.03], [0.03, 0.03], [0.03, 0.08], [0.0, 0.08]];
+    let vertices: Vec<[f64; 3]> =
+        [0.0, 0.02].iter().flat_map(|&z| l.iter().map(move |&[x, y]| [x, y, z])).collect();
+    let top: Vec<usize> = vec![7, 8, 9, 10, 11, 6];
+    let bottom: Vec<usize> = vec![5, 4, 3, 2, 1, 0];
+    let mut faces = vec![top, bottom];
+    faces.extend((0..6).map(|i| vec![i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6]));
+    let corners =
+        |f: &[usize], base: usize| f.iter().map(|v| (v + base).to_string()).collect::<Vec<_>>().join(" ");
+    let points: String = vertices.iter().map(|p| format!("{} {} {}\n", p[0], p[1], p[2])).collect();
+    let obj = vertices.iter().map(|p| format!("v {} {} {}\n", p[0], p[1], p[2])).collect::<String>()
+        + &faces.iter().map(|f| format!("f {}\n", corners(f, 1))).collect::<String>();
+    let off = format!("OFF\n12 {} 0\n{points}", faces.len())
+        + &faces.iter().map(|f| format!("{} {}\n", f.len(), corners(f, 0))).collect::<String>();
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 12\nproperty double x\nproperty double y\nproperty double z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n{points}",
+        faces.len()
+    ) + &faces.iter().map(|f| format!("{} {}\n", f.len(), corners(f, 0))).collect::<String>();
+    for (bytes, format) in [(obj, SurfaceFormat::Obj), (off, SurfaceFormat::Off), (ply, SurfaceFormat::Ply)] {
+        let (s, report) = parse_surface(bytes.as_bytes(), format, 1.0, None).unwrap();
+        assert_eq!(s.triangles.len(), 2 * 4 + 6 * 2, "{format:?}");
+        assert!(report.is_clean(), "{format:?}: {report:?}");
+        assert!((report.enclosed_volume_m3 - 0.02 * (0.1 * 0.03 + 0.03 * 0.05)).abs() < 1e-15, "{format:?}");
+        // A fan folds over the notch: its triangles' areas, unsigned, add up
+        // to more than the prism's surface (two caps and the sides).
+        let unsigned_area: f64 = s.triangles.iter().map(|t| area(t.map(|v| s.vertices[v]))).sum();
+        let surface = 2.0 * (0.1 * 0.03 + 0.03 * 0.05) + 0.36 * 0.02;
+        assert!(
+            (unsigned_area - surface).abs() < 1e-15,
+            "{format:?}: {unsigned_area} m² against {surface} m²"
+        );
+    }
+}
+
+fn area([a, b, c]: [[f64; 3]; 3]) -> f64 {
+    let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
 }

@@ -227,6 +227,14 @@ fn an_open_disc_given_a_sheet_thickness_rings_like_a_free_kirchhoff_plate() {
     assert!(worst_rel(&ours, &want) < 0.015, "{ours:?} against {want:?}");
 }
 
+/// The flat-wall rule's edge for a plate of one-side `area` [m²] sized for its
+/// `mode`-th mode: a twelfth of that mode's bending wavelength (Weyl) [m].
+fn flat_edge(area: f64, mode: f64) -> f64 {
+    std::f64::consts::TAU
+        / (4.0 * std::f64::consts::PI * mode / area).sqrt()
+        / modal_tetra::FLAT_CELLS_PER_WAVELENGTH
+}
+
 #[test]
 fn a_wide_plate_is_sized_by_its_modes_not_by_its_wall() {
     // A 24 cm disc 1 mm thick: two walls along it would be 2 mm edges and
@@ -235,9 +243,7 @@ fn a_wide_plate_is_sized_by_its_modes_not_by_its_wall() {
     let (radius, h) = (0.12, 0.001);
     let options = TetOptions { sheet_thickness: Some(h), ..Default::default() };
     let (mesh, report) = tetrahedralize(&disc(radius, 0.0, 12, 64, false), &options).unwrap();
-    let area = std::f64::consts::PI * radius * radius;
-    let wavelength = std::f64::consts::TAU / (4.0 * std::f64::consts::PI * 64.0 / area).sqrt();
-    let flat = wavelength / modal_tetra::FLAT_CELLS_PER_WAVELENGTH;
+    let flat = flat_edge(std::f64::consts::PI * radius * radius, 64.0);
     assert!(
         report.cell_m > 0.9 * flat && report.cell_m <= flat * 1.000001,
         "{} m against {flat} m",
@@ -256,6 +262,34 @@ fn a_wide_plate_is_sized_by_its_modes_not_by_its_wall() {
         report.cell_m * 1e3
     );
     assert!(worst_rel(&ours, &want) < 0.015, "{ours:?} against {want:?}");
+}
+
+#[test]
+fn a_plate_exported_as_twelve_triangles_is_refined_to_the_wall_rule() {
+    // CAD exports a box as two triangles a face: the skin starts from edges of
+    // the plate's diagonal (25 cm) and needs 14 passes of longest-edge
+    // bisection to reach the flat rule's 3.2 mm; a cap of 12 passes left it
+    // at 3.9 mm whatever the rule asked. A bank of N modes sizes for the
+    // (N/2)-th (128: still the 64th); one of 1024 asks for edges below two
+    // walls, so the curved rule's two walls hold.
+    let (lx, ly, t) = (0.2, 0.15, 0.001);
+    let plate = shapes::cuboid(lx, ly, t);
+    let flat = |mode: f64| flat_edge(lx * ly, mode);
+    let mut sizes = Vec::new();
+    for (modes, limit) in [(64, flat(64.0)), (128, flat(64.0)), (256, flat(128.0)), (1024, 2.0 * t)] {
+        let options = TetOptions { resolved_modes: modes, curved: false, ..Default::default() };
+        let (_, report) = tetrahedralize(&plate, &options).unwrap();
+        assert_eq!(report.wall_layers, 1, "{report:?}");
+        // Bisection halves an edge every second pass: the longest lands within √2 below the limit.
+        assert!(
+            report.cell_m <= limit * 1.000001 && report.cell_m > limit / 2.0,
+            "{modes} modes: edges up to {} m against the rule's {limit} m",
+            report.cell_m
+        );
+        sizes.push(report.cell_m);
+    }
+    assert_eq!(sizes[1], sizes[0], "128 modes: the default plate");
+    assert!(sizes[2] < sizes[0], "more modes, finer plate: {sizes:?}");
 }
 
 #[test]

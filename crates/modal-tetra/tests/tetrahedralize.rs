@@ -106,6 +106,15 @@ fn options_control_resolution_and_guard_size() {
     // A sheet thickness changes the mesh, so the key; without one the key is the old one.
     assert_ne!(a, TetOptions { sheet_thickness: Some(0.002), ..Default::default() }.cache_key_fields());
     assert!(!a.contains("sheet"), "{a}");
+    // A bank of more than 128 modes changes a plate's mesh, so the key; 128 or fewer
+    // are the default mesh and keep the old key.
+    let modes = |n| TetOptions { resolved_modes: n, ..Default::default() }.cache_key_fields();
+    assert_ne!(a, modes(129));
+    // Banks of 129 and 130 modes size plates for the same (65th) mode: one mesh, one key.
+    assert_eq!(modes(129), modes(130));
+    assert_eq!(a, modes(128));
+    assert_eq!(a, modes(64));
+    assert_eq!(a, modes(10));
 }
 
 #[test]
@@ -188,6 +197,151 @@ fn robust_duplicate_vertices_and_degenerate_triangles() {
     assert_eq!(modal_tetra::diagnose(&degenerate).degenerate_triangles, 3);
     let r = mesh(&degenerate);
     assert!(rel(r.volume_m3, clean.volume_m3).abs() < 1e-12);
+}
+
+/// Exporters write faces twice: repeated (a duplicated export), or once per
+/// side (a double-sided export, whose winding number is 0 everywhere, so it
+/// enclosed nothing and was refused). Each meshes as the one-sided sphere,
+/// node for node, and says what it ignored.
+#[test]
+fn robust_faces_written_twice_mesh_like_the_one_sided_surface() {
+    let base = sphere();
+    let (clean, _) = tetrahedralize(&base, &TetOptions::default()).unwrap();
+    let front = base.triangles.clone();
+    let back: Vec<[usize; 3]> = front.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let with = |triangles: Vec<[usize; 3]>, vertices: Vec<[f64; 3]>| TriSurface {
+        parts: vec![("twice".into(), 0..triangles.len())],
+        vertices,
+        triangles,
+    };
+    let n = base.vertices.len();
+    let doubled_vertices = [base.vertices.clone(), base.vertices.clone()].concat();
+    let cases = [
+        ("repeated", with([front.clone(), front.clone()].concat(), base.vertices.clone()), (front.len(), 0)),
+        (
+            "double-sided",
+            with([front.clone(), back.clone()].concat(), base.vertices.clone()),
+            (0, front.len()),
+        ),
+        (
+            "double-sided, back first, on its own vertices",
+            with(
+                back.iter().map(|t| t.map(|v| v + n)).chain(front.iter().copied()).collect(),
+                doubled_vertices,
+            ),
+            (0, front.len()),
+        ),
+    ];
+    for (name, surface, (repeated, double_sided)) in cases {
+        let report = modal_tetra::diagnose(&surface);
+        assert_eq!(
+            (report.repeated_triangles, report.double_sided_faces),
+            (repeated, double_sided),
+            "{name}"
+        );
+        assert_eq!((report.open_boundary_edges, report.non_manifold_edges), (0, 0), "{name}");
+        assert!(report.warnings.iter().any(|w| w.contains("each face is meshed once")), "{name}: {report:?}");
+        let (m, _) = tetrahedralize(&surface, &TetOptions::default()).unwrap();
+        assert_eq!((m.nodes.len(), m.cells.len()), (clean.nodes.len(), clean.cells.len()), "{name}");
+        assert_eq!(m.nodes, clean.nodes, "{name}");
+    }
+}
+
+/// A double-sided open sheet (a flag or a sign beside a body, written once
+/// per side) encloses nothing: one side alone would make the winding number
+/// ±½ around it and stuff an arbitrary slab, so both are left out, with a
+/// warning, unless the sheet is given a thickness, when one side is kept
+/// and thickened like any sheet.
+#[test]
+fn robust_a_double_sided_sheet_is_left_out_unless_given_a_thickness() {
+    let body = shapes::cuboid(0.1, 0.06, 0.04);
+    let mut sheet = TriSurface {
+        vertices: vec![[0.15, 0.0, 0.0], [0.25, 0.0, 0.0], [0.25, 0.06, 0.0], [0.15, 0.06, 0.0]],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]],
+        parts: Vec::new(),
+    };
+    sheet.parts = vec![("flag".into(), 0..4)];
+    let s = union(&body, &sheet);
+    let report = modal_tetra::diagnose(&s);
+    assert_eq!(report.double_sided_sheet_faces, 2, "{report:?}");
+    assert!(report.warnings.iter().any(|w| w.contains("--sheet-thickness")), "{:?}", report.warnings);
+    // The flag alone is refused, saying why.
+    let err = tetrahedralize(&sheet, &TetOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("written once for each side") && err.contains("--sheet-thickness"), "{err}");
+    let (with_flag, r) = tetrahedralize(&s, &TetOptions::default()).unwrap();
+    assert!(rel(r.volume_m3, 0.1 * 0.06 * 0.04).abs() < 1e-12, "the body alone: {r:?}");
+    assert_eq!(modal_mesh::check(with_flag).unwrap().1.parts, 1);
+    let thick = TetOptions { sheet_thickness: Some(0.002), ..TetOptions::default() };
+    let (two_sides, _) = tetrahedralize(&s, &thick).unwrap();
+    sheet.triangles.truncate(2);
+    let (one_side, r) = tetrahedralize(&union(&body, &sheet), &thick).unwrap();
+    assert!(rel(r.surface_volume_m3, 0.1 * 0.06 * (0.04 + 0.002)).abs() < 1e-12, "{r:?}");
+    assert_eq!(two_sides.nodes, one_side.nodes);
+}
+
+/// A separate part much thinner than the body's cell (a 2 mm plate beside a
+/// 10 × 6 × 4 cm box) got no tets, or slivers hanging on edges: the mesh lost
+/// a body. It is meshed on its own now, at its own size or an explicit cell,
+/// and the two parts together hold both volumes.
+#[test]
+fn robust_a_thin_separate_part_is_meshed_on_its_own() {
+    let body = shapes::cuboid(0.1, 0.06, 0.04);
+    let mut plate = shapes::cuboid(0.1, 0.06, 0.002);
+    translate(&mut plate, [0.15, 0.0, 0.0]);
+    let s = union(&body, &plate);
+    let both = 0.1 * 0.06 * (0.04 + 0.002);
+    for options in [TetOptions::default(), TetOptions { cell: Some(0.0039), ..TetOptions::default() }] {
+        let (m, r) = tetrahedralize(&s, &options).unwrap();
+        assert!(rel(r.volume_m3, both).abs() < 2e-3, "{options:?}: {r:?}");
+        assert!(r.warnings.iter().any(|w| w.contains("meshed on its own")), "{:?}", r.warnings);
+        assert_eq!(modal_mesh::check(m).unwrap().1.parts, 2, "{options:?}");
+    }
+}
+
+/// Two bricks modelled touching face to face (a stack): the shared face is
+/// written by each, facing opposite ways. Both are dropped, which leaves the
+/// winding number as it was and the stack's closed, manifold surface.
+#[test]
+fn robust_bricks_touching_face_to_face_are_one_body() {
+    let a = shapes::cuboid(0.2, 0.1, 0.05);
+    let mut b = a.clone();
+    translate(&mut b, [0.0, 0.0, 0.05]);
+    let s = union(&a, &b);
+    let report = modal_tetra::diagnose(&s);
+    assert_eq!(report.touching_triangles, 4);
+    assert_eq!((report.open_boundary_edges, report.non_manifold_edges, report.components), (0, 0, 1));
+    assert!(rel(report.enclosed_volume_m3, 2e-3).abs() < 1e-12, "{report:?}");
+    let r = mesh(&s);
+    assert!(rel(r.volume_m3, 2e-3).abs() < 1e-12, "{r:?}");
+    let (m, _) = tetrahedralize(&s, &TetOptions::default()).unwrap();
+    assert_eq!(modal_mesh::check(m).unwrap().1.parts, 1);
+}
+
+/// A corner of one triangle on another's edge (a T-junction, as CAD and
+/// level-editor exports leave them) made the box open along that edge: its
+/// sharp edge was not found and the mesh missed it by 1 mm, with a false
+/// "thinner than the cells" warning. Stitched, the box meshes node for node
+/// like the clean one.
+#[test]
+fn robust_a_t_junction_meshes_like_the_closed_surface() {
+    let clean = shapes::cuboid(0.1, 0.06, 0.04);
+    let mut s = clean.clone();
+    // Corner 8 half-way along the top face's edge 4-5; the front face keeps 4-5 whole.
+    s.vertices.push([0.05, 0.0, 0.04]);
+    s.triangles.retain(|t| *t != [4, 5, 6] && *t != [5, 7, 6]);
+    assert_eq!(s.triangles.len(), 10);
+    s.triangles.extend([[4, 8, 6], [8, 7, 6], [8, 5, 7]]);
+    s.parts = vec![("box".into(), 0..s.triangles.len())];
+    let report = modal_tetra::diagnose(&s);
+    assert_eq!((report.t_junctions, report.open_boundary_edges), (1, 0), "{report:?}");
+    let (a, _) = tetrahedralize(&clean, &TetOptions::default()).unwrap();
+    let (b, r) = tetrahedralize(&s, &TetOptions::default()).unwrap();
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    assert_eq!((a.nodes.len(), a.cells.len()), (b.nodes.len(), b.cells.len()));
+    let moved =
+        a.nodes.iter().zip(&b.nodes).map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f64::max));
+    let moved = moved.fold(0.0, f64::max);
+    assert!(moved < 1e-12 && r.max_surface_deviation_m < 1e-9, "{moved:e}, {r:?}");
 }
 
 #[test]

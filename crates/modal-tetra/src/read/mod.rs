@@ -12,6 +12,7 @@ mod gltf_file;
 mod obj;
 mod off;
 mod ply;
+mod polygon;
 mod stl;
 
 pub use gltf_file::gltf_buffers;

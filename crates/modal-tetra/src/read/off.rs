@@ -1,6 +1,6 @@
 //! Geomview OFF (ASCII), the format of the Princeton Shape Benchmark and of
 //! ModelNet: a header keyword, the counts `V F E`, `V` lines of `x y z`,
-//! then `F` lines of `n i₁ … iₙ`; polygons are fan-triangulated.
+//! then `F` lines of `n i₁ … iₙ`; polygons are triangulated by `polygon`.
 //!
 //! Written here rather than through the `off-rs` crate, which reads
 //! coordinates as `f32` (a CAD export's micrometre detail lost at metre
@@ -12,6 +12,7 @@
 //! clear error: binary OFF, other dimensions than 3 (`4OFF`, `nOFF`), and
 //! counts the file cannot hold (nothing is allocated for them first).
 
+use super::polygon::Triangulator;
 use crate::{TetraError, TriSurface};
 
 fn bad(message: impl Into<String>) -> TetraError {
@@ -87,6 +88,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<TriSurface, TetraError> {
         let coordinate = |k: usize| number::<f64>(words[k], line, "coordinate");
         surface.vertices.push([coordinate(0)?, coordinate(1)?, coordinate(2)?]);
     }
+    let mut triangulator = Triangulator::new();
     for f in 0..face_count {
         let (line, words) = tokens
             .next_line()
@@ -109,9 +111,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<TriSurface, TetraError> {
             }
             ids.push(vertex);
         }
-        for k in 1..corners - 1 {
-            surface.triangles.push([ids[0], ids[k], ids[k + 1]]);
-        }
+        triangulator.push(&surface.vertices, &ids, &mut surface.triangles);
     }
     surface.parts.push(("off".to_string(), 0..surface.triangles.len()));
     Ok(surface)

@@ -1,10 +1,11 @@
 //! PLY (ASCII or binary) through `ply-rs-bw`: element `vertex` with x, y, z
 //! and element `face` with a `vertex_indices` (or `vertex_index`) list;
-//! polygons are fan-triangulated.
+//! polygons are triangulated by `polygon`.
 
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 
+use super::polygon::Triangulator;
 use crate::{TetraError, TriSurface};
 
 fn parse_err(message: impl Into<String>) -> TetraError {
@@ -52,6 +53,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<TriSurface, TetraError> {
     }
     let faces = ply.payload.get("face").ok_or_else(|| parse_err("no `face` element"))?;
     let count = surface.vertices.len();
+    let mut triangulator = Triangulator::new();
     for (f, face) in faces.iter().enumerate() {
         let list = face
             .get("vertex_indices")
@@ -71,9 +73,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<TriSurface, TetraError> {
                 }
             }
         }
-        for k in 1..idx.len() - 1 {
-            surface.triangles.push([idx[0], idx[k], idx[k + 1]]);
-        }
+        triangulator.push(&surface.vertices, &idx, &mut surface.triangles);
     }
     surface.parts.push(("ply".to_string(), 0..surface.triangles.len()));
     Ok(surface)
