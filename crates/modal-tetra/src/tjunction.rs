@@ -11,7 +11,10 @@
 //! Each open edge is split at every open-edge corner that lies on it, within
 //! [`ON_EDGE`] of the bounding-box diagonal, and its triangle is fanned anew:
 //! from the opposite corner when one edge is split, from a new centre vertex
-//! when more are. The seam then closes.
+//! when more are. The seam then closes. A face written twice (a
+//! double-sided export) counts as one face on its edges, and both copies are
+//! split alike: otherwise each T-junction edge, used by the face and its
+//! copy, looked closed, and the side left open was taken for a sheet.
 
 use std::collections::HashMap;
 
@@ -54,8 +57,13 @@ pub(crate) fn split_t_junctions(
     split_triangles.dedup();
     let mut added = Vec::new();
     let mut inserted = 0;
+    // Copies of one face (same corners, either winding) share their centre
+    // vertex and count their inserted corners once.
+    let mut centres: HashMap<[usize; 3], usize> = HashMap::new();
     for t in split_triangles {
         let tri = triangles[t];
+        let mut face = tri;
+        face.sort_unstable();
         let mut outline = Vec::new();
         for (k, &corner) in tri.iter().enumerate() {
             outline.push(corner);
@@ -68,15 +76,21 @@ pub(crate) fn split_t_junctions(
             // One corner on two of its edges: a sliver beyond repair here.
             continue;
         }
-        inserted += outline.len() - 3;
+        let first_copy = !centres.contains_key(&face);
+        if first_copy {
+            inserted += outline.len() - 3;
+        }
         let split_edges = (0..3).filter(|&k| splits.contains_key(&(t, k))).count();
         let fan = if split_edges == 1 {
+            centres.insert(face, usize::MAX);
             let k = (0..3).find(|&k| splits.contains_key(&(t, k))).unwrap_or(0);
             Fan::FromCorner(tri[(k + 2) % 3])
         } else {
-            let centre = scale(tri.iter().fold([0.0; 3], |s, &v| add(s, vertices[v])), 1.0 / 3.0);
-            vertices.push(centre);
-            Fan::FromCentre(vertices.len() - 1)
+            let centre = *centres.entry(face).or_insert_with(|| {
+                vertices.push(scale(tri.iter().fold([0.0; 3], |s, &v| add(s, vertices[v])), 1.0 / 3.0));
+                vertices.len() - 1
+            });
+            Fan::FromCentre(centre)
         };
         let pieces = fan.triangles(&outline);
         debug_assert!(pieces.len() >= 2, "a split triangle gives at least two");
@@ -111,9 +125,12 @@ impl Fan {
     }
 }
 
-/// Edges used by one triangle only, as (triangle, local edge k), sorted.
-/// A sort of packed keys, not a hash map: this runs on every input, scans of
-/// a million triangles included.
+/// Edges of one face only, as (triangle, local edge k), sorted. A face
+/// written more than once (a double-sided or duplicated export) counts once,
+/// and each of its copies is listed: they are split alike, so the copies stay
+/// coincident for module `coincident`. The faces on an edge are told apart by
+/// their third corner. A sort of packed keys, not a hash map: this runs on
+/// every input, scans of a million triangles included.
 fn open_edges(triangles: &[[usize; 3]]) -> Vec<(usize, usize)> {
     // (edge's two corners, 3 · triangle + k); corner indices fit in 32 bits
     // for any surface that fits in memory, as do the triangle slots.
@@ -125,10 +142,15 @@ fn open_edges(triangles: &[[usize; 3]]) -> Vec<(usize, usize)> {
         }
     }
     edges.sort_unstable();
+    let slot = |s: u64| (s as usize / 3, s as usize % 3);
+    let third = |s: u64| {
+        let (t, k) = slot(s);
+        triangles[t][(k + 2) % 3]
+    };
     let mut open: Vec<(usize, usize)> = edges
         .chunk_by(|x, y| x.0 == y.0)
-        .filter(|group| group.len() == 1)
-        .map(|group| (group[0].1 as usize / 3, group[0].1 as usize % 3))
+        .filter(|group| group.iter().all(|e| third(e.1) == third(group[0].1)))
+        .flat_map(|group| group.iter().map(|e| slot(e.1)))
         .collect();
     open.sort_unstable();
     open
@@ -251,6 +273,40 @@ mod tests {
             .collect();
         open.sort_unstable();
         assert_eq!(open, vec![(0, 2), (0, 9), (2, 9)], "{t:?}");
+    }
+
+    /// The same box written double-sided (every face again, reversed): the
+    /// T-junction edge is used by the face and its copy, yet it is open, and
+    /// both copies are split alike, so they stay opposite pairs.
+    #[test]
+    fn a_double_sided_t_junction_is_split_on_both_sides() {
+        let (mut v, mut t) = box_with_t_junction();
+        let back: Vec<[usize; 3]> = t.iter().map(|&[a, b, c]| [a, c, b]).collect();
+        t.extend(back);
+        assert_eq!(open_edges(&t).len(), 6, "three edges, each on a face and its copy");
+        assert_eq!(split_t_junctions(&mut v, &mut t, 0.1237), 1, "one corner inserted");
+        assert!(open_edges(&t).is_empty(), "{t:?}");
+        let mut faces: Vec<[usize; 3]> = t
+            .iter()
+            .map(|x| {
+                let mut k = *x;
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        faces.sort_unstable();
+        assert!(faces.chunks(2).all(|pair| pair[0] == pair[1]), "every face twice: {faces:?}");
+    }
+
+    /// Two edges split on a face written twice: the copies share one centre.
+    #[test]
+    fn copies_of_a_face_split_on_two_edges_share_its_centre() {
+        let mut v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.5, 0.0, 0.0], [0.5, 0.5, 0.0]];
+        let mut t = vec![[0, 1, 2], [0, 2, 1], [3, 0, 9], [1, 3, 9], [4, 1, 9], [2, 4, 9]];
+        v.resize(10, [0.3, 0.3, 1.0]);
+        assert_eq!(split_t_junctions(&mut v, &mut t, 1.0), 2);
+        assert_eq!(v.len(), 11, "one centre vertex for both copies");
+        assert_eq!(t.len(), 4 + 2 * 5);
     }
 
     #[test]
