@@ -1,7 +1,8 @@
 //! Input diagnostics and orientation repair of a triangle surface.
 //!
 //! Steps: weld vertices closer than 1e-10 × the bounding-box diagonal (count
-//! duplicates), drop triangles that collapse to zero area (count degenerates),
+//! duplicates), drop triangles that collapse at that tolerance (count
+//! degenerates),
 //! split edges at T-junctions (module `tjunction`), drop faces written twice
 //! (module `coincident`), classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
 //! or more), then orient triangles consistently across manifold edges per
@@ -13,7 +14,7 @@
 use std::collections::HashMap;
 
 use crate::coincident::{drop_coincident, Coincident, Sheets};
-use crate::geom::{cross, dot, norm, sub, V3};
+use crate::geom::{cross, dot, norm, scale, sub, V3};
 use crate::nesting::{nest, Component};
 use crate::tjunction::split_t_junctions;
 use crate::TriSurface;
@@ -107,6 +108,10 @@ pub fn diagnose(surface: &TriSurface) -> SurfaceReport {
     repair(surface).report
 }
 
+/// Vertices closer than this fraction of the bounding-box diagonal are one
+/// vertex, and a triangle that thin has no area.
+const WELD_TOLERANCE: f64 = 1e-10;
+
 /// Welds, cleans and orients `surface` (module doc). A double-sided open
 /// sheet is dropped: it encloses nothing.
 pub(crate) fn repair(surface: &TriSurface) -> Repaired {
@@ -131,13 +136,20 @@ fn repair_with(surface: &TriSurface, sheets: Sheets) -> Repaired {
         report.bbox_max = hi;
         report.diagonal_m = norm(sub(hi, lo));
     }
-    let (vertices, map, duplicates) = weld(surface, report.diagonal_m * 1e-10);
+    let weld_tol = report.diagonal_m * WELD_TOLERANCE;
+    let on_edge = report.diagonal_m * crate::tjunction::ON_EDGE;
+    let (vertices, map, duplicates) = weld(surface, weld_tol);
     report.duplicate_vertices = duplicates;
     let mut triangles = Vec::with_capacity(surface.triangles.len());
     for t in &surface.triangles {
         let t = t.map(|v| map[v]);
-        let n = cross(sub(vertices[t[1]], vertices[t[0]]), sub(vertices[t[2]], vertices[t[0]]));
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || norm(n) == 0.0 {
+        let corners = t.map(|v| vertices[v]);
+        if t[0] == t[1]
+            || t[1] == t[2]
+            || t[0] == t[2]
+            || collapses(corners, weld_tol)
+            || fills(corners, on_edge)
+        {
             report.degenerate_triangles += 1;
         } else {
             triangles.push(t);
@@ -159,8 +171,48 @@ fn repair_with(surface: &TriSurface, sheets: Sheets) -> Repaired {
     Repaired { vertices, triangles, report, components }
 }
 
+/// True when the triangle collapses at the weld tolerance `tol`: a corner
+/// lies within `tol` of the line through the opposite (longest) edge, as two
+/// corners within `tol` of each other are welded into one. Its height is
+/// `|(b − a) × (c − a)| / ℓ`, ℓ the longest edge. An exact zero test kept the
+/// slivers exporters leave at a split edge (a corner interpolated on the
+/// opposite edge, off it by rounding): their edges made the edge they lie on
+/// non-manifold, and the repair of the faces around it went wrong.
+fn collapses([a, b, c]: [V3; 3], tol: f64) -> bool {
+    let n = norm(cross(sub(b, a), sub(c, a)));
+    let longest = [sub(b, a), sub(c, b), sub(a, c)].iter().map(|e| dot(*e, *e)).fold(0.0, f64::max);
+    n <= tol * longest.sqrt()
+}
+
+/// True when a corner lies on the opposite edge, strictly inside it, within
+/// `tol` ([`crate::tjunction::ON_EDGE`] of the diagonal): a sliver filling
+/// the gap between an edge and the same edge split at that corner, as some
+/// exporters close a T-junction. Written with 6 or 9 digits, its corner is
+/// off the edge by the rounding, far more than the weld tolerance, so
+/// [`collapses`] keeps it; its edges then made the edge non-manifold. Dropped,
+/// it leaves a T-junction, which is stitched. (A needle, whose corner is near
+/// an end of the opposite edge, is not a filler: dropping it would open a
+/// hole nothing closes.)
+fn fills(corners: [V3; 3], tol: f64) -> bool {
+    (0..3).any(|k| {
+        let (x, p, q) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
+        let d = sub(q, p);
+        let length = norm(d);
+        let along = dot(sub(x, p), d) / length;
+        let off = norm(sub(sub(x, p), scale(d, along / length)));
+        length > 2.0 * tol && along > tol && along < length - tol && off <= tol
+    })
+}
+
 /// Merges vertices on a grid of spacing `tol`; returns the welded vertices,
-/// the old → new map and the number of merged vertices.
+/// the old → new map and the number of merged vertices. A vertex joins the
+/// first vertex of its own cell (closer than `tol` in every coordinate). A
+/// vertex alone in its cell joins the nearest first vertex of a neighbouring
+/// cell within `tol / 2` in every coordinate (the lowest-numbered on ties):
+/// copies of one corner rounded apart fell into neighbouring cells whenever
+/// they straddled a cell boundary, however close they were. Within `tol / 2`,
+/// a neighbour can only lie across the boundaries the vertex is nearer to:
+/// seven cells to look in, not 26.
 fn weld(surface: &TriSurface, tol: f64) -> (Vec<V3>, Vec<usize>, usize) {
     let tol = if tol > 0.0 { tol } else { f64::MIN_POSITIVE };
     let mut index: HashMap<[i64; 3], usize> = HashMap::with_capacity(surface.vertices.len());
@@ -170,28 +222,44 @@ fn weld(surface: &TriSurface, tol: f64) -> (Vec<V3>, Vec<usize>, usize) {
             used[v] = true;
         }
     }
-    let mut vertices = Vec::new();
+    let mut vertices: Vec<V3> = Vec::new();
     let mut duplicates = 0;
-    let map = surface
-        .vertices
-        .iter()
-        .zip(&used)
-        .map(|(p, &u)| {
-            let key = p.map(|c| (c / tol).round() as i64);
-            match index.get(&key) {
-                Some(&i) => {
-                    duplicates += usize::from(u);
-                    i
-                }
-                None => {
-                    vertices.push(*p);
-                    index.insert(key, vertices.len() - 1);
-                    vertices.len() - 1
-                }
+    let mut map = Vec::with_capacity(surface.vertices.len());
+    for (p, &u) in surface.vertices.iter().zip(&used) {
+        let key = p.map(|c| (c / tol).round() as i64);
+        let joined = index.get(&key).copied().or_else(|| neighbour_within(&index, &vertices, *p, tol));
+        map.push(match joined {
+            Some(i) => {
+                duplicates += usize::from(u);
+                i
             }
-        })
-        .collect();
+            None => {
+                vertices.push(*p);
+                index.insert(key, vertices.len() - 1);
+                vertices.len() - 1
+            }
+        });
+    }
     (vertices, map, duplicates)
+}
+
+/// The first vertex of one of the seven cells across the boundaries nearest
+/// to `p` that lies within `tol / 2` of `p` in every coordinate: the nearest,
+/// the lowest-numbered on ties.
+fn neighbour_within(index: &HashMap<[i64; 3], usize>, vertices: &[V3], p: V3, tol: f64) -> Option<usize> {
+    let scaled = p.map(|c| c / tol);
+    let key = scaled.map(|c| c.round() as i64);
+    let toward: [i64; 3] = std::array::from_fn(|c| if scaled[c] >= key[c] as f64 { 1 } else { -1 });
+    let mut best: Option<(f64, usize)> = None;
+    for step in 1..8 {
+        let cell: [i64; 3] = std::array::from_fn(|c| key[c] + toward[c] * ((step >> c) & 1));
+        let Some(&i) = index.get(&cell) else { continue };
+        let gap = (0..3).map(|c| (vertices[i][c] - p[c]).abs()).fold(0.0, f64::max);
+        if gap <= 0.5 * tol && best.is_none_or(|(g, j)| (gap, i) < (g, j)) {
+            best = Some((gap, i));
+        }
+    }
+    best.map(|(_, i)| i)
 }
 
 /// Orients triangles consistently per component; returns how many were
