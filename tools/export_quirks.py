@@ -21,6 +21,18 @@ or a small variation on one, so a run says at once whether the quirk changed the
   box_and_plate.obj              the box and, 5 cm from it, a separate 10 x 6 cm plate 2 mm thick
   box_rotated.obj                the box turned 0.5 rad about z, then 0.3 rad about x
 
+Quirks combined (the fifth sweep, BENCHMARKS.md "A fifth sweep: quirks combined"):
+
+  box_double_sided_t_junction.obj   box_t_junction.obj written double-sided
+  box_half_double_sided.obj         the box with every other triangle written again, reversed
+  box_rotated_6digits.obj           box_rotated.obj written with 6 significant digits
+  box_rotated_filler_6digits.obj    the same with its top face split a third of the way along an
+                                    edge and the gap filled by a zero-area sliver, as some
+                                    exporters fill a split edge (6 digits: the sliver's corner is
+                                    off the edge by the rounding)
+  box_rotated_soup_ulps.obj         box_rotated.obj as an unwelded soup whose copies of a corner
+                                    differ by up to 2e-12 m (per-face transforms), 17 digits
+
 Needs numpy. Usage: python tools/export_quirks.py OUT_DIR
 """
 import os
@@ -174,3 +186,29 @@ a, b = 0.5, 0.3
 turn = np.array([[1, 0, 0], [0, np.cos(b), -np.sin(b)], [0, np.sin(b), np.cos(b)]]) @ \
     np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
 write("box_rotated.obj", BOX_V @ turn.T, BOX_F)
+
+# --- Quirks combined (fifth sweep). Appended: the files above stay byte for byte.
+write("box_double_sided_t_junction.obj", t_v, t_f + reversed_faces(t_f))
+write("box_half_double_sided.obj", BOX_V, BOX_F + reversed_faces(BOX_F[::2]))
+
+
+def write_digits(name, V, F, digits):
+    with open(f"{out}/{name}", "w") as f:
+        for v in V:
+            f.write(("v %.{0}g %.{0}g %.{0}g\n".format(digits)) % tuple(v))
+        for t in F:
+            f.write("f " + " ".join(str(k + 1) for k in t) + "\n")
+
+
+R = BOX_V @ turn.T
+write_digits("box_rotated_6digits.obj", R, BOX_F, 6)
+# Top face z = 0.04 (corners 1, 3, 5, 7) split at a third of edge 1-5; the front face (0, 5, 1)
+# keeps 5-1 whole, and the sliver (1, 5, m) fills the gap between them.
+m = R[1] + (R[5] - R[1]) / 3
+RF = np.vstack([R, [m]])
+FF = [t for t in BOX_F if t != (1, 5, 7)] + [(1, 8, 7), (8, 5, 7), (1, 5, 8)]
+write_digits("box_rotated_filler_6digits.obj", RF, FF, 6)
+soup_rng = np.random.default_rng(11)
+SV = np.array([R[k] + soup_rng.uniform(-2e-12, 2e-12, 3) for t in BOX_F for k in t])
+write_digits("box_rotated_soup_ulps.obj", SV, [(3 * i, 3 * i + 1, 3 * i + 2) for i in range(len(BOX_F))], 17)
+
