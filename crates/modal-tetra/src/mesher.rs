@@ -134,7 +134,7 @@ impl TetOptions {
             String::new()
         };
         format!(
-            "tetra=stuffing-v13;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
+            "tetra=stuffing-v14;cell={:?};target_tets={:?};cells_per_diagonal={};cells_per_thickness={};features={};curved={};graded={};default_max_tets={};size_factor={}",
             self.cell,
             self.target_tets,
             self.cells_per_diagonal,
