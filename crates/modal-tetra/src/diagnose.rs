@@ -198,9 +198,12 @@ fn fills(corners: [V3; 3], tol: f64) -> bool {
         let (x, p, q) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
         let d = sub(q, p);
         let length = norm(d);
+        if length <= 2.0 * tol {
+            return false;
+        }
         let along = dot(sub(x, p), d) / length;
         let off = norm(sub(sub(x, p), scale(d, along / length)));
-        length > 2.0 * tol && along > tol && along < length - tol && off <= tol
+        along > tol && along < length - tol && off <= tol
     })
 }
 
