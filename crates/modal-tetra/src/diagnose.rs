@@ -1,11 +1,10 @@
 //! Input diagnostics and orientation repair of a triangle surface.
 //!
 //! Steps: weld vertices closer than 1e-10 × the bounding-box diagonal (count
-//! duplicates), drop triangles that collapse at that tolerance (count
-//! degenerates),
-//! split edges at T-junctions (module `tjunction`), drop faces written twice
-//! (module `coincident`), classify edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3
-//! or more), then orient triangles consistently across manifold edges per
+//! duplicates), drop triangles that collapse at that tolerance or fill a
+//! split edge (count degenerates), split edges at T-junctions (module
+//! `tjunction`), drop faces written twice (module `coincident`), classify
+//! edges (open boundary = 1 triangle, manifold = 2, non-manifold = 3 or more), then orient triangles consistently across manifold edges per
 //! connected component (breadth-first) and flip a component whose signed
 //! volume is negative, except the inner walls of hollow objects, which keep
 //! facing inward (module `nesting`). The repaired triangles feed the
@@ -14,9 +13,9 @@
 use std::collections::HashMap;
 
 use crate::coincident::{drop_coincident, Coincident, Sheets};
-use crate::geom::{cross, dot, norm, scale, sub, V3};
+use crate::geom::{cross, dot, norm, sub, V3};
 use crate::nesting::{nest, Component};
-use crate::tjunction::split_t_junctions;
+use crate::tjunction::{inside_segment, split_t_junctions};
 use crate::TriSurface;
 
 /// What was wrong with an input surface (all counts refer to the input).
@@ -138,7 +137,7 @@ fn repair_with(surface: &TriSurface, sheets: Sheets) -> Repaired {
     }
     let weld_tol = report.diagonal_m * WELD_TOLERANCE;
     let on_edge = report.diagonal_m * crate::tjunction::ON_EDGE;
-    let (vertices, map, duplicates) = weld(surface, weld_tol);
+    let (mut vertices, map, duplicates) = weld(surface, weld_tol);
     report.duplicate_vertices = duplicates;
     let mut triangles = Vec::with_capacity(surface.triangles.len());
     for t in &surface.triangles {
@@ -155,7 +154,6 @@ fn repair_with(surface: &TriSurface, sheets: Sheets) -> Repaired {
             triangles.push(t);
         }
     }
-    let mut vertices = vertices;
     report.t_junctions = split_t_junctions(&mut vertices, &mut triangles, report.diagonal_m);
     let coincident = drop_coincident(&mut triangles, sheets);
     report.repeated_triangles = coincident.repeated;
@@ -194,17 +192,7 @@ fn collapses([a, b, c]: [V3; 3], tol: f64) -> bool {
 /// an end of the opposite edge, is not a filler: dropping it would open a
 /// hole nothing closes.)
 fn fills(corners: [V3; 3], tol: f64) -> bool {
-    (0..3).any(|k| {
-        let (x, p, q) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
-        let d = sub(q, p);
-        let length = norm(d);
-        if length <= 2.0 * tol {
-            return false;
-        }
-        let along = dot(sub(x, p), d) / length;
-        let off = norm(sub(sub(x, p), scale(d, along / length)));
-        along > tol && along < length - tol && off <= tol
-    })
+    (0..3).any(|k| inside_segment(corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3], tol).is_some())
 }
 
 /// Merges vertices on a grid of spacing `tol`; returns the welded vertices,

@@ -16,7 +16,7 @@
 //! split alike: otherwise each T-junction edge, used by the face and its
 //! copy, looked closed, and the side left open was taken for a sheet.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use crate::geom::{add, dot, norm, scale, sub, V3};
 
@@ -57,8 +57,9 @@ pub(crate) fn split_t_junctions(
     split_triangles.dedup();
     let mut added = Vec::new();
     let mut inserted = 0;
-    // Copies of one face (same corners, either winding) share their centre
-    // vertex and count their inserted corners once.
+    // Copies of one face (same corners, either winding) count their inserted
+    // corners once and share their centre vertex.
+    let mut counted: HashSet<[usize; 3]> = HashSet::new();
     let mut centres: HashMap<[usize; 3], usize> = HashMap::new();
     for t in split_triangles {
         let tri = triangles[t];
@@ -76,13 +77,11 @@ pub(crate) fn split_t_junctions(
             // One corner on two of its edges: a sliver beyond repair here.
             continue;
         }
-        let first_copy = !centres.contains_key(&face);
-        if first_copy {
+        if counted.insert(face) {
             inserted += outline.len() - 3;
         }
         let split_edges = (0..3).filter(|&k| splits.contains_key(&(t, k))).count();
         let fan = if split_edges == 1 {
-            centres.insert(face, usize::MAX);
             let k = (0..3).find(|&k| splits.contains_key(&(t, k))).unwrap_or(0);
             Fan::FromCorner(tri[(k + 2) % 3])
         } else {
@@ -193,15 +192,25 @@ impl OpenCorners {
             .iter()
             .take_while(|&&v| vertices[v][axis] <= hi)
             .filter(|&&v| v != a && v != b)
-            .filter_map(|&v| {
-                let along = dot(sub(vertices[v], pa), d) / length;
-                let off = norm(sub(sub(vertices[v], pa), scale(d, along / length)));
-                (along > tol && along < length - tol && off <= tol).then_some((along, v))
-            })
+            .filter_map(|&v| inside_segment(vertices[v], pa, pb, tol).map(|along| (along, v)))
             .collect();
         found.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         found
     }
+}
+
+/// How far from `p` the point `x` lies along segment `p q` when it lies on
+/// it strictly inside: within `tol` of it, and farther than `tol` from
+/// either end; `None` otherwise (and for a segment of at most `2 tol`).
+pub(crate) fn inside_segment(x: V3, p: V3, q: V3, tol: f64) -> Option<f64> {
+    let d = sub(q, p);
+    let length = norm(d);
+    if length <= 2.0 * tol {
+        return None;
+    }
+    let along = dot(sub(x, p), d) / length;
+    let off = norm(sub(sub(x, p), scale(d, along / length)));
+    (along > tol && along < length - tol && off <= tol).then_some(along)
 }
 
 #[cfg(test)]
