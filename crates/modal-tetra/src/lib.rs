@@ -11,7 +11,9 @@
 //!
 //! Pipeline ([`tetrahedralize`]):
 //! 1. [`diagnose`]: weld, drop degenerates, classify edges, orient triangles
-//!    consistently per component, outward by signed volume ([`SurfaceReport`]).
+//!    consistently per component, outward by signed volume ([`SurfaceReport`]),
+//!    and put the surface in a canonical order (module `canonical`): the mesh
+//!    depends on the geometry, not on the order of the file's triangles.
 //! 2. Inside/outside: generalized winding number ≥ ½ (Jacobson et al. 2013)
 //!    with a BVH dipole far field (module `bvh`).
 //! 3. Isosurface stuffing on a BCC lattice of cell size h (Labelle & Shewchuk
@@ -59,6 +61,7 @@
 //! [`TetraError::Parse`]; the default panic hook may still print it).
 
 mod bvh;
+mod canonical;
 mod coarsen;
 mod coincident;
 pub mod corpus;

@@ -94,14 +94,21 @@ pub(crate) fn nest(vertices: &[V3], triangles: &[[usize; 3]], components: &[Comp
     nesting
 }
 
-/// Up to [`SAMPLES`] vertices spread over the component's triangles.
+/// Up to [`SAMPLES`] of the component's distinct vertices, spread over
+/// their (canonical, by position) numbering: all of them for a small part.
+/// First corners of every few triangles depended on how each triangle was
+/// written, and a box crossing the side of an L-bracket was taken as nested
+/// when the one corner outside was never a first corner.
 fn samples<'a>(
     vertices: &'a [V3],
     triangles: &'a [[usize; 3]],
     c: &'a Component,
 ) -> impl Iterator<Item = V3> + 'a {
-    let step = c.triangles.len().div_ceil(SAMPLES).max(1);
-    c.triangles.iter().step_by(step).map(move |&t| vertices[triangles[t][0]])
+    let mut corners: Vec<usize> = c.triangles.iter().flat_map(|&t| triangles[t]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let step = corners.len().div_ceil(SAMPLES).max(1);
+    corners.into_iter().step_by(step).map(move |v| vertices[v])
 }
 
 fn bounding_box(vertices: &[V3], triangles: &[[usize; 3]], members: &[usize]) -> (V3, V3) {
