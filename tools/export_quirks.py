@@ -33,7 +33,12 @@ Quirks combined (the fifth sweep, BENCHMARKS.md "A fifth sweep: quirks combined"
   box_rotated_soup_ulps.obj         box_rotated.obj as an unwelded soup whose copies of a corner
                                     differ by up to 2e-12 m (per-face transforms), 17 digits
 
-Needs numpy. Usage: python tools/export_quirks.py OUT_DIR
+A dense scan (BENCHMARKS.md, "The noise of a dense scan is not a sharp feature"), only with
+--scan-1m, since it is a 57 MB file:
+
+  scan_1m.obj                    scan_327k.obj's ellipsoid at 1 310 720 triangles, the same noise
+
+Needs numpy. Usage: python tools/export_quirks.py OUT_DIR [--scan-1m]
 """
 import os
 import struct
@@ -211,4 +216,7 @@ write_digits("box_rotated_filler_6digits.obj", RF, FF, 6)
 soup_rng = np.random.default_rng(11)
 SV = np.array([R[k] + soup_rng.uniform(-2e-12, 2e-12, 3) for t in BOX_F for k in t])
 write_digits("box_rotated_soup_ulps.obj", SV, [(3 * i, 3 * i + 1, 3 * i + 2) for i in range(len(BOX_F))], 17)
-
+if "--scan-1m" in sys.argv[2:]:
+    V, F = icosphere(8)
+    V = V * (1 + 0.002 * np.random.default_rng(3).standard_normal(len(V)))[:, None] * np.array([0.06, 0.06, 0.09])
+    write("scan_1m.obj", V, F)

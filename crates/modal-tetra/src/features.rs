@@ -29,6 +29,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
+use crate::chains::followable;
 use crate::geom::{
     add, cross, dihedral_angles_deg, dot, lerp, norm, orient6, scale, segment_triangle, sub, V3,
 };
@@ -75,7 +76,7 @@ pub(crate) fn features(
     // (a, b, mean normal) of every sharp input edge; per vertex the sum of the
     // mean normals of its sharp edges and their count.
     let mut sharp: Vec<(usize, usize, V3)> = Vec::new();
-    let mut at_vertex: HashMap<usize, (usize, V3)> = HashMap::new();
+    let mut convex: Vec<bool> = Vec::new();
     for pair in edges.windows(2) {
         let (x, y) = (pair[0], pair[1]);
         if (x.0, x.1) != (y.0, y.1) {
@@ -85,11 +86,19 @@ pub(crate) fn features(
         if dot(n1, n2) < cos_limit {
             let mean = unit(add(n1, n2)).unwrap_or(n1);
             sharp.push((x.0, x.1, mean));
-            for v in [x.0, x.1] {
-                let e = at_vertex.entry(v).or_insert((0, [0.0; 3]));
-                e.0 += 1;
-                e.1 = add(e.1, mean);
-            }
+            // Convex when the far corner of one face lies below the other's plane.
+            let far = triangles[y.2].into_iter().find(|&v| v != x.0 && v != x.1).unwrap_or(x.0);
+            convex.push(dot(n1, sub(vertices[far], vertices[x.0])) < 0.0);
+        }
+    }
+    // Not the noise of a scan (module `chains`).
+    let sharp = followable(sharp, &convex, vertices, h);
+    let mut at_vertex: HashMap<usize, (usize, V3)> = HashMap::new();
+    for &(a, b, mean) in &sharp {
+        for v in [a, b] {
+            let e = at_vertex.entry(v).or_insert((0, [0.0; 3]));
+            e.0 += 1;
+            e.1 = add(e.1, mean);
         }
     }
     let mut lines: Vec<([V3; 2], V3)> =

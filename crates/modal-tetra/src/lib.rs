@@ -26,7 +26,9 @@
 //!    get their own copies of the shared nodes (separate bodies), so no
 //!    output tets are joined by an edge or a vertex only.
 //! 5. Sharp features (module `features`): boundary nodes near sharp input
-//!    edges and corners are moved onto them when quality allows.
+//!    edges and corners are moved onto them when quality allows; only edges
+//!    in chains a cell can follow count, not a dense scan's noise (module
+//!    `chains`).
 //! 6. Curved boundary (module `curve`): 10-node tets, boundary mid-edge
 //!    nodes moved to the closest surface point, guarded by a Jacobian check
 //!    with a straight fallback per element ([`MIN_JACOBIAN_RATIO`]).
@@ -62,6 +64,7 @@
 
 mod bvh;
 mod canonical;
+mod chains;
 mod coarsen;
 mod coincident;
 pub mod corpus;
@@ -88,6 +91,7 @@ mod thicken;
 mod tjunction;
 mod wall_rule;
 
+pub use chains::MIN_CHAIN_FRACTION;
 pub use curve::{MAX_BULGE, MIN_JACOBIAN_RATIO};
 pub use diagnose::{diagnose, SurfaceReport};
 pub use error::TetraError;
