@@ -18,7 +18,7 @@ use std::collections::HashMap;
 
 use crate::canonical::{canonical, Canonical};
 use crate::coincident::{drop_coincident, Coincident, Sheets};
-use crate::geom::{add, cross, dot, norm, scale, sub, V3};
+use crate::geom::{add, area_vector, cross, dot, norm, scale, sub, V3};
 use crate::nesting::{nest, Component};
 use crate::tjunction::{inside_segment, split_t_junctions};
 use crate::TriSurface;
@@ -105,6 +105,38 @@ pub(crate) struct Repaired {
     /// The components `triangles` fall into, joined across manifold edges only.
     pub components: Vec<Component>,
 }
+
+impl Repaired {
+    /// Area of the solid's boundary (m²): the triangles, plus, for each open
+    /// part that encloses a volume, the caps its holes are closed by (the
+    /// winding number caps a planar hole flat). A cap's area is at least the
+    /// length of the part's vector area `|Σ_t (b − a) × (c − a) / 2|` (a closed
+    /// surface has none; equal for a planar hole). Without the caps, `2V/A` read
+    /// an open cymbal, filled to its rim, as a wall twice as thick as it is. A
+    /// part enclosing less than [`CAPPED_DEPTH`] of its cap's size (a flat sheet,
+    /// whose cap is the sheet itself and whose solid is empty) gets none.
+    pub(crate) fn solid_area(&self) -> f64 {
+        let triangle = |t: usize| {
+            let [a, b, c] = self.triangles[t].map(|v| self.vertices[v]);
+            area_vector(a, b, c)
+        };
+        let sides: f64 = (0..self.triangles.len()).map(|t| norm(triangle(t))).sum();
+        let caps: f64 = self
+            .components
+            .iter()
+            .filter(|c| !c.closed)
+            .map(|c| (c.volume, norm(c.triangles.iter().fold([0.0; 3], |sum, &t| add(sum, triangle(t))))))
+            .filter(|&(volume, cap)| volume > CAPPED_DEPTH * cap.powf(1.5))
+            .map(|(_, cap)| cap)
+            .sum();
+        sides + caps
+    }
+}
+
+/// Volume over cap area^(3/2) below which an open part is a sheet, not a
+/// vessel (a shallow cymbal 2 cm deep and 30 cm across has 0.037; a sheet
+/// bent by 1° about 10⁻³).
+const CAPPED_DEPTH: f64 = 1e-3;
 
 /// Diagnoses `surface` (see the module doc). Never fails; an empty surface
 /// gives an all-zero report.

@@ -9,7 +9,7 @@ use crate::curve::curve;
 use crate::diagnose::repair;
 use crate::diagnose::Repaired;
 use crate::features::{features, snap};
-use crate::geom::{add, area_vector, dihedral_angles_deg, norm, orient6, V3};
+use crate::geom::{dihedral_angles_deg, orient6, V3};
 use crate::graded::MAX_LEVELS;
 use crate::lattice::Lattice;
 use crate::rescue::{clear, lost, mesh_alone, parts, triangles_outside};
@@ -333,7 +333,7 @@ pub fn tetrahedralize(
     }
     let (lo, hi) = surface.bounding_box().ok_or(TetraError::Empty)?;
     let diagonal = repaired.report.diagonal_m;
-    let area = solid_area(&repaired);
+    let area = repaired.solid_area();
     let volume = repaired.report.enclosed_volume_m3;
     let h0 = cell_size(options, diagonal, volume, area)?;
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
@@ -632,36 +632,6 @@ fn stuff_surface(
     };
     Ok((stuffed, h, thin_samples, min_thickness_m))
 }
-
-/// Area of the solid's boundary (m²): the triangles, plus, for each open
-/// part that encloses a volume, the caps its holes are closed by (the
-/// winding number caps a planar hole flat). A cap's area is at least the
-/// length of the part's vector area `|Σ_t (b − a) × (c − a) / 2|` (a closed
-/// surface has none; equal for a planar hole). Without the caps, `2V/A` read
-/// an open cymbal, filled to its rim, as a wall twice as thick as it is. A
-/// part enclosing less than [`CAPPED_DEPTH`] of its cap's size (a flat sheet,
-/// whose cap is the sheet itself and whose solid is empty) gets none.
-fn solid_area(repaired: &Repaired) -> f64 {
-    let triangle = |t: usize| {
-        let [a, b, c] = repaired.triangles[t].map(|v| repaired.vertices[v]);
-        area_vector(a, b, c)
-    };
-    let sides: f64 = (0..repaired.triangles.len()).map(|t| norm(triangle(t))).sum();
-    let caps: f64 = repaired
-        .components
-        .iter()
-        .filter(|c| !c.closed)
-        .map(|c| (c.volume, norm(c.triangles.iter().fold([0.0; 3], |sum, &t| add(sum, triangle(t))))))
-        .filter(|&(volume, cap)| volume > CAPPED_DEPTH * cap.powf(1.5))
-        .map(|(_, cap)| cap)
-        .sum();
-    sides + caps
-}
-
-/// Volume over cap area^(3/2) below which an open part is a sheet, not a
-/// vessel (a shallow cymbal 2 cm deep and 30 cm across has 0.037; a sheet
-/// bent by 1° about 10⁻³).
-const CAPPED_DEPTH: f64 = 1e-3;
 
 fn cell_size(options: &TetOptions, diagonal: f64, volume: f64, area: f64) -> Result<f64, TetraError> {
     let positive = |name: &'static str, x: f64| {
