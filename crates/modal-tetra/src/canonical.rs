@@ -21,7 +21,7 @@
 
 use std::cmp::Ordering;
 
-use crate::geom::V3;
+use crate::geom::{bounds, V3};
 
 /// A surface in canonical order, and where each input triangle went.
 pub(crate) struct Canonical {
@@ -64,14 +64,7 @@ pub(crate) fn canonical(vertices: &[V3], triangles: &[[usize; 3]]) -> Canonical 
     let mut used = vec![false; vertices.len()];
     triangles.iter().flatten().for_each(|&v| used[v] = true);
     let mut order: Vec<usize> = (0..vertices.len()).filter(|&v| used[v]).collect();
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &v in &order {
-        for c in 0..3 {
-            lo[c] = lo[c].min(vertices[v][c]);
-            hi[c] = hi[c].max(vertices[v][c]);
-        }
-    }
+    let (lo, hi) = bounds(order.iter().map(|&v| vertices[v]));
     let extent = (0..3).map(|c| hi[c] - lo[c]).fold(0.0, f64::max);
     let per_metre = if extent > 0.0 { ((1u64 << MORTON_BITS) - 1) as f64 / extent } else { 0.0 };
     let keys: Vec<u64> = vertices.iter().map(|p| morton(p, &lo, per_metre)).collect();

@@ -21,7 +21,7 @@
 //! edges); noise makes short chains that meet only each other, and those
 //! are dropped.
 
-use crate::geom::{dot, norm, sub, V3};
+use crate::geom::{bounds, dot, norm, sub, V3};
 
 /// Chains spanning at least this fraction of the cell h are followed.
 pub const MIN_CHAIN_FRACTION: f64 = 0.5;
@@ -53,17 +53,14 @@ pub(crate) fn followable(
             continue;
         }
         let id = chains.len();
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let mut members = Vec::new();
         let mut ends = Vec::new();
         let mut stack = vec![first];
         chain_of[first] = id;
         while let Some(e) = stack.pop() {
             let (a, b, _) = sharp[e];
             for v in [a, b] {
-                for c in 0..3 {
-                    lo[c] = lo[c].min(vertices[v][c]);
-                    hi[c] = hi[c].max(vertices[v][c]);
-                }
+                members.push(v);
                 if degree(v) != 2 {
                     ends.push(v);
                     continue;
@@ -78,6 +75,7 @@ pub(crate) fn followable(
                 }
             }
         }
+        let (lo, hi) = bounds(members.into_iter().map(|v| vertices[v]));
         chains.push((norm(sub(hi, lo)), ends));
     }
     let long: Vec<bool> = chains.iter().map(|(extent, _)| *extent >= MIN_CHAIN_FRACTION * h).collect();

@@ -490,7 +490,7 @@ fn signed_volume(
         let [a, b, c] = triangles[t].map(|v| sub(vertices[v], origin));
         let v = dot(a, cross(b, c)) / 6.0;
         volume += if flip[t] { -v } else { v };
-        area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+        area += norm(area_vector(a, b, c));
     }
     // A flat part (a lone triangle of a cracked soup, a flat sheet) encloses
     // nothing, but its sum is rounding of either sign: read as a volume it

@@ -20,7 +20,7 @@
 //! container is the smallest such, among the [`MAX_CONTAINERS`] largest.
 
 use crate::bvh::Bvh;
-use crate::geom::V3;
+use crate::geom::{bounds, V3};
 
 /// Vertices of a component tested against a container.
 const SAMPLES: usize = 16;
@@ -112,17 +112,7 @@ fn samples<'a>(
 }
 
 fn bounding_box(vertices: &[V3], triangles: &[[usize; 3]], members: &[usize]) -> (V3, V3) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in members {
-        for &v in &triangles[t] {
-            for a in 0..3 {
-                lo[a] = lo[a].min(vertices[v][a]);
-                hi[a] = hi[a].max(vertices[v][a]);
-            }
-        }
-    }
-    (lo, hi)
+    bounds(members.iter().flat_map(|&t| triangles[t]).map(|v| vertices[v]))
 }
 
 fn box_inside(inner: (V3, V3), outer: (V3, V3)) -> bool {
