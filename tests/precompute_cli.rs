@@ -362,6 +362,42 @@ fn a_glb_or_off_without_a_modal_model_is_meshed_like_the_same_obj() {
 }
 
 #[test]
+fn a_file_in_millimetres_is_refused_at_once_and_solved_with_its_scale() {
+    // 3D printing and CAD write millimetres; read as metres, this 40 mm steel block
+    // is 40 m long, every mode lies far below the band, and the solve used to fail
+    // after minutes (a mug: 3 min 10 s, then "eigensolver stalled").
+    let dir = temp_dir();
+    let size_mm = [40.0, 20.0, 16.0];
+    let obj = std::fs::File::create(dir.path().join("block_mm.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(size_mm[0], size_mm[1], size_mm[2]), obj).unwrap();
+    let precompute = |input: &str, extra: &[&str]| {
+        let args = ["precompute", input, "-o", "b.bank", "--no-cache", "--material", "steel", "--modes", "4"];
+        modal(
+            dir.path(),
+            &[&args[..], &["--cell", "0.008", "--max-freq", "1e6", "--accuracy", "off", "--json"], extra]
+                .concat(),
+        )
+    };
+    let refused = precompute("block_mm.obj", &[]).fails_with("--scale 0.001");
+    assert!(refused.stderr.contains("47.5 m across"), "{}", refused.stderr);
+    assert!(!dir.path().join("b.bank").exists(), "no output for a refused file");
+    // The same for a tet mesh file (`mesh tet` only warns: meshing is cheap).
+    let meshed =
+        modal(dir.path(), &["mesh", "tet", "block_mm.obj", "-o", "block_mm.msh", "--cell", "8"]).ok();
+    assert!(meshed.stderr.contains("--scale 0.001"), "{}", meshed.stderr);
+    precompute("block_mm.msh", &[]).fails_with("--scale 0.001");
+    // With its scale it is the 40 mm block, and its modes are those of the file in metres.
+    let in_metres = std::fs::File::create(dir.path().join("block.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(0.04, 0.02, 0.016), in_metres).unwrap();
+    let scaled = frequencies(&precompute("block_mm.obj", &["--scale", "0.001"]).ok().json());
+    let metres = frequencies(&precompute("block.obj", &[]).ok().json());
+    assert_eq!(scaled.len(), 4);
+    for (a, b) in scaled.iter().zip(&metres) {
+        assert!((a / b - 1.0).abs() < 1e-9, "scaled {a} Hz against {b} Hz in metres");
+    }
+}
+
+#[test]
 fn surface_options_on_a_tet_mesh_are_named_not_dropped() {
     let dir = temp_dir();
     let bar = example("bar_p1.msh");

@@ -173,3 +173,35 @@ rotation = { euler = [-80.0, 0.0, 0.0] }
     assert!(object["modes_synthesized"].as_u64().unwrap() > 0, "{object}");
     assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
 }
+
+#[test]
+fn a_mesh_in_millimetres_is_refused_until_the_scene_gives_its_scale() {
+    // A 10 cm wooden bar written in millimetres is a 100 m bar read as metres:
+    // refused at once, naming the key; with `scale = 0.001` it falls and rings.
+    let dir = temp_dir();
+    let bar = std::fs::File::create(dir.path().join("bar_mm.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(100.0, 20.0, 10.0), bar).unwrap();
+    let scene = r#"
+duration = 0.3
+sample_rate = 16000
+[listener]
+position = [0.0, 0.2, 0.5]
+channels = "mono"
+radiation = "estimate"
+[ground]
+material = "wood"
+[[objects]]
+mesh = "bar_mm.obj"
+material = "wood"
+position = [0.0, 0.05, 0.0]
+"#;
+    std::fs::write(dir.path().join("mm.toml"), scene).unwrap();
+    modal(dir.path(), &["render", "mm.toml", "-o", "mm.wav"]).fails_with("`scale = 0.001`");
+    assert!(!dir.path().join("mm.wav").exists());
+    let scaled =
+        scene.replace("material = \"wood\"\nposition", "material = \"wood\"\nscale = 0.001\nposition");
+    std::fs::write(dir.path().join("scaled.toml"), scaled).unwrap();
+    let report = modal(dir.path(), &["render", "scaled.toml", "-o", "scaled.wav", "--json"]).ok().json();
+    assert!(report["objects"][0]["modes_synthesized"].as_u64().unwrap() > 0, "{report}");
+    assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
+}

@@ -74,9 +74,10 @@ pub struct MeshInputArgs {
     /// Element order: 2 = quadratic 10-node tets (default), 1 = linear 4-node tets.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
-    /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres).
-    #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
-    pub scale: f64,
+    /// Multiply all coordinates by S (e.g. 0.001 for a file in millimetres) [default: 1]. Files
+    /// carry no unit: an object more than 20 m across is refused as millimetres unless S is given.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub scale: Option<f64>,
     /// Lattice cell size [m] when tetrahedralizing a surface mesh (OBJ/STL/PLY/OFF/glTF); on a thin
     /// shell (a wall thinner than the cell / 1.5), the longest tet edge along the wall.
     #[arg(long, value_name = "H")]

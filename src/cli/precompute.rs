@@ -18,7 +18,8 @@ fn request(mesh: &Path, material_args: &MaterialArgs, input: &MeshInputArgs) -> 
     let (material, warnings) = material::resolve(material_args)?;
     warnings.iter().for_each(|w| warn(w));
     let mut request = Request::new(MeshSource::File(mesh.to_path_buf()), material);
-    request.scale = input.scale;
+    request.scale = input.scale.unwrap_or(1.0);
+    request.scale_stated = input.scale.is_some();
     request.order = input.order;
     request.surface = SurfaceMeshing {
         cell: input.cell,

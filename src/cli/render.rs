@@ -330,7 +330,8 @@ impl PipelineProvider<'_> {
     /// The precompute request for a scene object's bank.
     fn request(&self, request: &BankRequest, material: Material, source: MeshSource) -> Request {
         let mut pipeline = Request::new(source, material);
-        pipeline.scale = request.scale;
+        pipeline.scale = request.scale.unwrap_or(1.0);
+        pipeline.scale_stated = request.scale.is_some();
         pipeline.surface.sheet_thickness = request.sheet_thickness;
         pipeline.order = request.order.unwrap_or(2);
         // No modes above the scene's Nyquist frequency are worth solving for.

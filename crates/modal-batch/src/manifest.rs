@@ -342,6 +342,7 @@ impl Manifest {
         let file = if self.base == Path::new(".") { PathBuf::from(&path) } else { self.base.join(&path) };
         let mut request = Request::new(MeshSource::File(file), resolved.material);
         request.scale = o.scale.unwrap_or(1.0);
+        request.scale_stated = o.scale.is_some();
         request.order = o.order.unwrap_or(request.order);
         request.max_modes = o.modes.unwrap_or(request.max_modes);
         request.min_freq_hz = o.min_freq.unwrap_or(request.min_freq_hz);

@@ -13,6 +13,8 @@
 //!
 //! Conventions, stated once for the whole project:
 //! - Units: metres; readers multiply file coordinates by a caller's scale.
+//!   Files carry no unit, so a size that suggests millimetres is judged in
+//!   one place ([`unit_warning`], [`unstated_size_refusal`]).
 //! - Corner order: a tet `[a, b, c, d]` is positively oriented when
 //!   `(b − a) × (c − a) · (d − a) > 0` (six times its signed volume).
 //! - 10-node tets use the VTK edge order, see [`TET10_EDGES`]: node `4 + e`
@@ -35,6 +37,7 @@ mod promote;
 mod quality;
 mod surface;
 mod types;
+mod units;
 mod validate;
 
 pub mod generate;
@@ -51,6 +54,10 @@ pub use promote::{to_linear, to_quadratic, to_quadratic_with};
 pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;
 pub use types::*;
+pub use units::{
+    bounding_diagonal, unit_warning, unstated_size_refusal, LARGEST_PLAIN_DIAGONAL_M,
+    SMALLEST_PLAIN_DIAGONAL_M,
+};
 pub use validate::{
     check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO, SLIVER_ANGLE_DEG,
 };

@@ -23,7 +23,7 @@ pub use levels::{
     remeshable, AccuracyTarget, BAND_MARGIN, COARSE_FACTOR, LEVELS_VERSION, MAX_REFINEMENTS, MAX_STEP,
     MIN_STEP, PRESCRIBED_NOTE,
 };
-pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, SurfaceMeshing};
+pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, Scale, SurfaceMeshing};
 pub use pipeline::{
     assemble_matrices, precompute, residual_floor_warning, Assembled, Outcome, Request, Stage,
     TARGET_RESIDUAL,

@@ -146,10 +146,38 @@ pub fn is_surface_file(path: &Path) -> bool {
     modal_tetra::SurfaceFormat::from_path(path).is_some()
 }
 
+/// The factor applied to a mesh file's coordinates (0.001 for millimetres),
+/// and whether the caller stated it. Files carry no unit, so a file whose
+/// object would be larger than [`modal_mesh::LARGEST_PLAIN_DIAGONAL_M`] under
+/// an unstated scale is refused before any work as a file in another unit
+/// ([`modal_mesh::unstated_size_refusal`]); a stated scale takes any size as meant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale {
+    /// Factor applied to all coordinates.
+    pub factor: f64,
+    /// The caller stated `factor` (a flag, a manifest's or a scene's key).
+    pub stated: bool,
+}
+
+impl Scale {
+    /// A scale the caller stated.
+    pub fn stated(factor: f64) -> Self {
+        Scale { factor, stated: true }
+    }
+
+    /// The refusal of an object `diagonal_m` across under this scale, if any.
+    fn check(&self, diagonal_m: f64) -> Result<(), PrecomputeError> {
+        match modal_mesh::unstated_size_refusal(diagonal_m).filter(|_| !self.stated) {
+            Some(message) => Err(PrecomputeError::Invalid(message)),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Loads, (tetrahedralizes,) scales and checks a mesh.
 pub fn load_mesh(
     source: &MeshSource,
-    scale: f64,
+    scale: Scale,
     surface: &SurfaceMeshing,
 ) -> Result<LoadedMesh, PrecomputeError> {
     load_mesh_sized(source, scale, surface, None, None)
@@ -160,19 +188,21 @@ pub fn load_mesh(
 /// tetrahedralizer estimates more than `budget`'s tets. Tet meshes are not touched.
 pub(crate) fn load_mesh_sized(
     source: &MeshSource,
-    scale: f64,
+    scale: Scale,
     surface: &SurfaceMeshing,
     level: Option<LevelSize>,
     budget: Option<TetBudget>,
 ) -> Result<LoadedMesh, PrecomputeError> {
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {scale}")));
+    let factor = scale.factor;
+    if !(factor.is_finite() && factor > 0.0) {
+        return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {factor}")));
     }
     let mut warnings = Vec::new();
     let (mut cell_m, mut layered) = (None, false);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
-            let (surf, mut report) = modal_tetra::read_surface(path, scale, surface.part.as_deref())?;
+            let (surf, mut report) = modal_tetra::read_surface(path, factor, surface.part.as_deref())?;
+            scale.check(report.diagonal_m)?;
             if surface.sheet_thickness.is_some() {
                 report.drop_open_warning();
             }
@@ -218,11 +248,15 @@ pub(crate) fn load_mesh_sized(
                     path.display()
                 ));
             }
-            modal_mesh::read_mesh(path, scale)?
+            let mesh = modal_mesh::read_mesh(path, factor)?;
+            let diagonal_m = modal_mesh::bounding_diagonal(&mesh.nodes);
+            scale.check(diagonal_m)?;
+            warnings.extend(modal_mesh::unit_warning(diagonal_m));
+            mesh
         }
         MeshSource::Memory { mesh, .. } => {
             let mut mesh = mesh.clone();
-            mesh.nodes.iter_mut().flatten().for_each(|x| *x *= scale);
+            mesh.nodes.iter_mut().flatten().for_each(|x| *x *= factor);
             mesh
         }
     };

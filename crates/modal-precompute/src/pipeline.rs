@@ -10,7 +10,7 @@ use modal_fem::Material;
 use modal_mesh::TetMesh;
 
 use crate::levels::AccuracyTarget;
-use crate::load::{load_mesh_sized, LevelSize, SurfaceMeshing, TetBudget};
+use crate::load::{load_mesh_sized, LevelSize, Scale, SurfaceMeshing, TetBudget};
 use crate::{cache_key, MeshSource, PrecomputeError};
 
 /// What to compute. `Default` gives the CLI's defaults for everything but
@@ -21,6 +21,11 @@ pub struct Request {
     pub source: MeshSource,
     /// Factor applied to all coordinates (e.g. 0.001 for millimetres).
     pub scale: f64,
+    /// The caller stated `scale` (`--scale`, a manifest's or a scene's key). Unstated,
+    /// a mesh file whose object is more than 20 m across is refused before any work as
+    /// a file in millimetres ([`crate::Scale`]). Not part of the cache key: it decides
+    /// whether a solve is attempted, not its result.
+    pub scale_stated: bool,
     /// Options for surface meshes (OBJ/STL/PLY/OFF/glTF).
     pub surface: SurfaceMeshing,
     /// Material, incl. Rayleigh damping.
@@ -54,6 +59,7 @@ impl Request {
         Request {
             source,
             scale: 1.0,
+            scale_stated: false,
             surface: SurfaceMeshing::default(),
             material,
             order: 2,
@@ -196,7 +202,8 @@ pub(crate) fn assemble_and_analyze(
     let budget = limit
         .filter(|_| request.order == 2)
         .map(|limit_bytes| TetBudget { limit_bytes, vector_bytes_per_dof });
-    let loaded = load_mesh_sized(&request.source, request.scale, &request.surface_meshing(), level, budget)?;
+    let scale = Scale { factor: request.scale, stated: request.scale_stated };
+    let loaded = load_mesh_sized(&request.source, scale, &request.surface_meshing(), level, budget)?;
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);

@@ -37,7 +37,7 @@ pub(crate) fn with_slab(scene: &Scene) -> Cow<'_, Scene> {
         bank: None,
         material: Some(g.material.clone()),
         order: None,
-        scale: 1.0,
+        scale: None,
         sheet_thickness: None,
         position_m: [g.center_m[0], g.height_m - 0.5 * t, g.center_m[1]],
         rotation: RotationSpec::default(),

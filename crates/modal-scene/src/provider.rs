@@ -24,8 +24,8 @@ pub struct BankRequest {
     pub material: Option<Material>,
     /// Element order 1 or 2, `None` = provider default.
     pub order: Option<u8>,
-    /// Uniform geometric scale of the mesh.
-    pub scale: f64,
+    /// Uniform geometric scale of the mesh (`None`: 1, not stated by the scene).
+    pub scale: Option<f64>,
     /// Wall thickness [m] given to a surface mesh's open parts (`None`: none).
     pub sheet_thickness: Option<f64>,
     /// Highest frequency worth solving for [Hz]: the scene's Nyquist frequency.

@@ -387,9 +387,10 @@ pub struct ObjectSpec {
     /// FEM element order 1 or 2 (provider default if absent).
     #[serde(default)]
     pub order: Option<u8>,
-    /// Uniform scale applied to the mesh (default 1).
-    #[serde(default = "defaults::one")]
-    pub scale: f64,
+    /// Uniform scale applied to the mesh (`None`: 1, unstated: a mesh file whose
+    /// object is more than 20 m across is then refused as millimetres).
+    #[serde(default)]
+    pub scale: Option<f64>,
     /// Wall thickness [m] given to every open part of a surface mesh file (a
     /// sheet modelled as one surface: a cymbal, a sign), as `modal precompute
     /// --sheet-thickness`; `None` (default): open parts are filled as their

@@ -134,7 +134,9 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
     if o.order.is_some_and(|n| n != 1 && n != 2) {
         return Err(SceneError::invalid(key("order"), "must be 1 or 2"));
     }
-    positive(&key("scale"), o.scale)?;
+    if let Some(scale) = o.scale {
+        positive(&key("scale"), scale)?;
+    }
     if let Some(t) = o.sheet_thickness {
         positive(&key("sheet_thickness"), t)?;
         if !matches!(&o.mesh, Some(MeshSource::File(_))) {

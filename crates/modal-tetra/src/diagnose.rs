@@ -242,7 +242,7 @@ fn repair_at(surface: &TriSurface, sheets: Sheets, weld_fraction: f64) -> Repair
     report.flipped_faces = flips;
     let (vertices, triangles, components) =
         in_canonical_order(&vertices, &triangles, components, &mut report);
-    report.warnings.extend(unit_warning(report.diagonal_m));
+    report.warnings.extend(modal_mesh::unit_warning(report.diagonal_m));
     report.warnings.extend(coincident_warning(&coincident));
     report.warnings.extend(sheet_sides_warning(coincident.double_sided_sheet));
     report.warnings.extend(open_warning(report.open_boundary_edges));
@@ -582,21 +582,5 @@ impl SurfaceReport {
         for w in sheet_warnings.into_iter().flatten() {
             self.warnings.retain(|x| *x != w);
         }
-    }
-}
-
-/// A warning when the size suggests the file is not in metres.
-fn unit_warning(diagonal: f64) -> Option<String> {
-    if diagonal > 20.0 {
-        Some(format!(
-            "the bounding box diagonal is {diagonal:.4} m: if the file is in millimetres use --scale 0.001, in centimetres --scale 0.01"
-        ))
-    } else if diagonal > 0.0 && diagonal < 0.005 {
-        Some(format!(
-            "the bounding box diagonal is only {:.4} mm: check the file's units and use --scale if it is not in metres",
-            diagonal * 1e3
-        ))
-    } else {
-        None
     }
 }

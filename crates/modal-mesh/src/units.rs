@@ -1,0 +1,89 @@
+//! Is a mesh file in metres? Mesh files carry no unit (OBJ, STL, PLY, OFF,
+//! Gmsh, TetGen, Medit), yet 3D printing and CAD write millimetres, and some
+//! tools centimetres or inches. Read as metres, a 12 cm mug written in
+//! millimetres is a 120 m object: its modes lie a thousand times lower, far
+//! below the audible band, and an eigen solve for that band runs minutes into
+//! a cluster of near-zero modes before it fails. The size of the object is
+//! the only clue, so it is judged here once for every reader.
+
+/// The largest bounding-box diagonal [m] taken as metres without a word: a
+/// sounding object larger than this (a bus, a bridge span) is rare, while any
+/// object of more than 20 mm written in millimetres lands above it.
+pub const LARGEST_PLAIN_DIAGONAL_M: f64 = 20.0;
+
+/// The smallest bounding-box diagonal [m] taken as metres without a word: a
+/// smaller object (a file in kilometres, or metres mistaken for millimetres)
+/// rings above any audio band.
+pub const SMALLEST_PLAIN_DIAGONAL_M: f64 = 0.005;
+
+/// The diagonal of the axis-aligned bounding box of `points` [m]; 0 for none.
+pub fn bounding_diagonal(points: &[[f64; 3]]) -> f64 {
+    let Some(first) = points.first() else { return 0.0 };
+    let (mut lo, mut hi) = (*first, *first);
+    for p in points {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// A warning when an object's bounding-box diagonal `diagonal_m` suggests its
+/// file is not in metres, naming the `--scale` that would fix it.
+pub fn unit_warning(diagonal_m: f64) -> Option<String> {
+    if diagonal_m > LARGEST_PLAIN_DIAGONAL_M {
+        Some(format!(
+            "the bounding box diagonal is {diagonal_m:.4} m: if the file is in millimetres use --scale 0.001, in centimetres --scale 0.01"
+        ))
+    } else if diagonal_m > 0.0 && diagonal_m < SMALLEST_PLAIN_DIAGONAL_M {
+        Some(format!(
+            "the bounding box diagonal is only {:.4} mm: check the file's units and use --scale if it is not in metres",
+            diagonal_m * 1e3
+        ))
+    } else {
+        None
+    }
+}
+
+/// Why an object of diagonal `diagonal_m` whose scale nobody stated is not
+/// solved: `Some(message)` above [`LARGEST_PLAIN_DIAGONAL_M`]. Said before
+/// the work, because the solve of such a file fails only after minutes (see
+/// the module doc). A stated scale (`--scale 1`) takes any size as meant.
+pub fn unstated_size_refusal(diagonal_m: f64) -> Option<String> {
+    (diagonal_m > LARGEST_PLAIN_DIAGONAL_M).then(|| {
+        format!(
+            "the object is {diagonal_m:.1} m across (bounding-box diagonal) and mesh files carry no unit: if the \
+             file is in millimetres give it a scale of 0.001 (--scale 0.001, or `scale = 0.001` in a scene or \
+             manifest), in centimetres 0.01, in inches 0.0254; to solve it at this size, state the scale \
+             (--scale 1)"
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_millimetre_mug_is_refused_and_a_metre_one_is_not() {
+        let mug_m = [[0.0, 0.0, 0.0], [0.12, 0.09, 0.1]];
+        let mug_mm = mug_m.map(|p| p.map(|x| x * 1000.0));
+        let (d_m, d_mm) = (bounding_diagonal(&mug_m), bounding_diagonal(&mug_mm));
+        assert!((d_mm - 1000.0 * d_m).abs() < 1e-9 * d_mm);
+        assert_eq!(unstated_size_refusal(d_m), None);
+        assert_eq!(unit_warning(d_m), None);
+        let refusal = unstated_size_refusal(d_mm).expect("a 180 m mug is refused");
+        assert!(refusal.contains("--scale 0.001") && refusal.contains("180.3 m across"), "{refusal}");
+        assert!(unit_warning(d_mm).is_some_and(|w| w.contains("--scale 0.001")));
+    }
+
+    #[test]
+    fn a_tiny_object_is_warned_about_not_refused() {
+        let bead = [[0.0; 3], [0.001, 0.001, 0.001]];
+        let d = bounding_diagonal(&bead);
+        assert_eq!(unstated_size_refusal(d), None);
+        assert!(unit_warning(d).is_some_and(|w| w.contains("check the file's units")));
+        assert_eq!(bounding_diagonal(&[]), 0.0);
+    }
+}
