@@ -140,15 +140,11 @@ fn a_generated_shape_beyond_the_memory_guard_is_refused_before_it_is_generated()
     modal_within_memory(dir.path(), &args, "lots").fails_with("MODAL_MEMORY_LIMIT_GB");
 }
 
-#[test]
-fn a_sheet_without_thickness_sounds_when_the_scene_gives_it_one() {
-    // A 10 cm square modelled as one surface (as asset packs ship sheet metal):
-    // it encloses nothing, so the render stops with a clear error; with
-    // `sheet_thickness` it is a 2 mm steel plate that falls and rings.
-    let dir = temp_dir();
-    let square = "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n";
-    std::fs::write(dir.path().join("sheet.obj"), square).unwrap();
-    let scene = r#"
+/// A scene of one object dropped on a wooden floor, heard 0.5 m away; `object`
+/// holds the object's keys (`mesh`, `material`, ...).
+fn one_object_dropped(object: &str) -> String {
+    format!(
+        r#"
 duration = 0.4
 sample_rate = 16000
 [listener]
@@ -158,20 +154,35 @@ radiation = "estimate"
 [ground]
 material = "wood"
 [[objects]]
-mesh = "sheet.obj"
-material = "steel"
+{object}
 position = [0.0, 0.05, 0.0]
-rotation = { euler = [-80.0, 0.0, 0.0] }
-"#;
-    std::fs::write(dir.path().join("bare.toml"), scene).unwrap();
-    modal(dir.path(), &["render", "bare.toml", "-o", "bare.wav"]).fails_with("--sheet-thickness");
-    let thick = scene.replace("material = \"steel\"", "material = \"steel\"\nsheet_thickness = 0.002");
-    std::fs::write(dir.path().join("thick.toml"), thick).unwrap();
-    let report = modal(dir.path(), &["render", "thick.toml", "-o", "thick.wav", "--json"]).ok().json();
+"#
+    )
+}
+
+/// Renders `scene` (written to `name`.toml) and asserts its first object rang.
+fn assert_rings(dir: &std::path::Path, name: &str, scene: &str) {
+    std::fs::write(dir.join(format!("{name}.toml")), scene).unwrap();
+    let args = ["render", &format!("{name}.toml"), "-o", &format!("{name}.wav"), "--json"];
+    let report = modal(dir, &args).ok().json();
     let object = &report["objects"][0];
     assert!(object["impacts"].as_u64().unwrap() >= 1, "{object}");
     assert!(object["modes_synthesized"].as_u64().unwrap() > 0, "{object}");
     assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
+}
+
+#[test]
+fn a_sheet_without_thickness_sounds_when_the_scene_gives_it_one() {
+    // A 10 cm square modelled as one surface (as asset packs ship sheet metal):
+    // it encloses nothing, so the render stops with a clear error; with
+    // `sheet_thickness` it is a 2 mm steel plate that falls and rings.
+    let dir = temp_dir();
+    let square = "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n";
+    std::fs::write(dir.path().join("sheet.obj"), square).unwrap();
+    let sheet = "mesh = \"sheet.obj\"\nmaterial = \"steel\"\nrotation = { euler = [-80.0, 0.0, 0.0] }";
+    std::fs::write(dir.path().join("bare.toml"), one_object_dropped(sheet)).unwrap();
+    modal(dir.path(), &["render", "bare.toml", "-o", "bare.wav"]).fails_with("--sheet-thickness");
+    assert_rings(dir.path(), "thick", &one_object_dropped(&format!("{sheet}\nsheet_thickness = 0.002")));
 }
 
 #[test]
@@ -181,27 +192,9 @@ fn a_mesh_in_millimetres_is_refused_until_the_scene_gives_its_scale() {
     let dir = temp_dir();
     let bar = std::fs::File::create(dir.path().join("bar_mm.obj")).unwrap();
     modal_tetra::write_obj(&modal_tetra::shapes::cuboid(100.0, 20.0, 10.0), bar).unwrap();
-    let scene = r#"
-duration = 0.3
-sample_rate = 16000
-[listener]
-position = [0.0, 0.2, 0.5]
-channels = "mono"
-radiation = "estimate"
-[ground]
-material = "wood"
-[[objects]]
-mesh = "bar_mm.obj"
-material = "wood"
-position = [0.0, 0.05, 0.0]
-"#;
-    std::fs::write(dir.path().join("mm.toml"), scene).unwrap();
+    let bar = "mesh = \"bar_mm.obj\"\nmaterial = \"wood\"";
+    std::fs::write(dir.path().join("mm.toml"), one_object_dropped(bar)).unwrap();
     modal(dir.path(), &["render", "mm.toml", "-o", "mm.wav"]).fails_with("`scale = 0.001`");
     assert!(!dir.path().join("mm.wav").exists());
-    let scaled =
-        scene.replace("material = \"wood\"\nposition", "material = \"wood\"\nscale = 0.001\nposition");
-    std::fs::write(dir.path().join("scaled.toml"), scaled).unwrap();
-    let report = modal(dir.path(), &["render", "scaled.toml", "-o", "scaled.wav", "--json"]).ok().json();
-    assert!(report["objects"][0]["modes_synthesized"].as_u64().unwrap() > 0, "{report}");
-    assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
+    assert_rings(dir.path(), "scaled", &one_object_dropped(&format!("{bar}\nscale = 0.001")));
 }
