@@ -16,16 +16,20 @@ pub const LARGEST_PLAIN_DIAGONAL_M: f64 = 20.0;
 /// rings above any audio band.
 pub const SMALLEST_PLAIN_DIAGONAL_M: f64 = 0.005;
 
+/// The bounding box (lower corner, upper corner) of `points`; (+∞, −∞) when
+/// there are none.
+pub fn bounding_box(points: impl IntoIterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
+    points.into_iter().fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
+        (std::array::from_fn(|c| lo[c].min(p[c])), std::array::from_fn(|c| hi[c].max(p[c])))
+    })
+}
+
 /// The diagonal of the axis-aligned bounding box of `points` [m]; 0 for none.
 pub fn bounding_diagonal(points: &[[f64; 3]]) -> f64 {
-    let Some(first) = points.first() else { return 0.0 };
-    let (mut lo, mut hi) = (*first, *first);
-    for p in points {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
+    if points.is_empty() {
+        return 0.0;
     }
+    let (lo, hi) = bounding_box(points.iter().copied());
     (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt()
 }
 

@@ -56,13 +56,9 @@ pub fn unit(v: V3) -> V3 {
     }
 }
 
-/// The bounding box (lower corner, upper corner) of `points`; (+∞, −∞) when
+/// The bounding box (lower corner, upper corner) of points; (+∞, −∞) when
 /// there are none.
-pub fn bounds(points: impl IntoIterator<Item = V3>) -> (V3, V3) {
-    points.into_iter().fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
-        (std::array::from_fn(|c| lo[c].min(p[c])), std::array::from_fn(|c| hi[c].max(p[c])))
-    })
-}
+pub use modal_mesh::bounding_box as bounds;
 
 /// Area vector ½ (b−a)×(c−a) of a triangle (outward for counter-clockwise).
 #[inline]

@@ -25,11 +25,8 @@ impl TriSurface {
     /// Axis-aligned bounding box `(min, max)` of the referenced vertices (m).
     /// `None` when there are no triangles.
     pub fn bounding_box(&self) -> Option<([f64; 3], [f64; 3])> {
-        let mut it = self.triangles.iter().flatten().map(|&v| self.vertices[v]);
-        let first = it.next()?;
-        Some(it.fold((first, first), |(lo, hi), p| {
-            (std::array::from_fn(|c| lo[c].min(p[c])), std::array::from_fn(|c| hi[c].max(p[c])))
-        }))
+        let corners = self.triangles.iter().flatten().map(|&v| self.vertices[v]);
+        (!self.triangles.is_empty()).then(|| crate::geom::bounds(corners))
     }
 
     /// Length of the bounding-box diagonal (m) (0 when empty).
