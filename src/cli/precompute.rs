@@ -36,6 +36,7 @@ fn describe(stage: &Stage) -> String {
         Stage::Assemble { dofs } => format!("assembling K and M ({dofs} DOF)"),
         Stage::Solve(what) => format!("eigen solve: {what}"),
         Stage::Store => "storing the bank in the cache".into(),
+        Stage::Warning(w) => format!("warning: {w}"),
         Stage::Level { index: 0, size_factor } if *size_factor == 1.0 => {
             "level 0 (requested element size)".into()
         }
@@ -101,15 +102,19 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     }
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
     let spinner = Spinner::new("starting");
+    // Warnings about the input are said when the mesh is read, once each, not after the solve.
+    let mut said = std::collections::HashSet::new();
     let outcome = modal_precompute::precompute(&request, cache.as_ref(), args.force, &mut |s| match s {
         Stage::Assemble { .. } | Stage::Level { .. } => {
             spinner.milestone(format!("precompute: {}", describe(&s)))
         }
+        Stage::Warning(w) if said.insert(w.clone()) => spinner.note(&describe(&Stage::Warning(w))),
+        Stage::Warning(_) => {}
         _ => spinner.set(describe(&s)),
     });
     spinner.finish();
     let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;
-    outcome.warnings.iter().for_each(|w| warn(w));
+    outcome.warnings.iter().filter(|w| !said.contains(*w)).for_each(|w| warn(w));
     if outcome.bank.mode_count() == 0 {
         warn(&format!(
             "no mode between --min-freq {} Hz and --max-freq {} Hz: the bank is silent (a small or stiff object \

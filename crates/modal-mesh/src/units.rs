@@ -11,6 +11,13 @@
 /// object of more than 20 mm written in millimetres lands above it.
 pub const LARGEST_PLAIN_DIAGONAL_M: f64 = 20.0;
 
+/// The largest bounding-box diagonal [m] taken as metres without a warning:
+/// a file in centimetres or inches of an object of 10–20 cm, or in millimetres
+/// of a bead, lands between this and [`LARGEST_PLAIN_DIAGONAL_M`] (a 12 cm mug
+/// in inches: 5.3 m, 24 t, its modes 40× too low), where real objects are rare
+/// but exist (a 3 m beam), so it is said, not refused.
+pub const LARGEST_UNREMARKED_DIAGONAL_M: f64 = 2.5;
+
 /// The smallest bounding-box diagonal [m] taken as metres without a word: a
 /// smaller object (a file in kilometres, or metres mistaken for millimetres)
 /// rings above any audio band.
@@ -39,6 +46,11 @@ pub fn unit_warning(diagonal_m: f64) -> Option<String> {
     if diagonal_m > LARGEST_PLAIN_DIAGONAL_M {
         Some(format!(
             "the bounding box diagonal is {diagonal_m:.4} m: if the file is in millimetres use --scale 0.001, in centimetres --scale 0.01"
+        ))
+    } else if diagonal_m > LARGEST_UNREMARKED_DIAGONAL_M {
+        Some(format!(
+            "the object is {diagonal_m:.2} m across (bounding-box diagonal): if the file is not in metres, give its \
+             scale (--scale 0.01 for centimetres, 0.0254 for inches, 0.001 for millimetres)"
         ))
     } else if diagonal_m > 0.0 && diagonal_m < SMALLEST_PLAIN_DIAGONAL_M {
         Some(format!(
@@ -80,6 +92,15 @@ mod tests {
         let refusal = unstated_size_refusal(d_mm).expect("a 180 m mug is refused");
         assert!(refusal.contains("--scale 0.001") && refusal.contains("180.3 m across"), "{refusal}");
         assert!(unit_warning(d_mm).is_some_and(|w| w.contains("--scale 0.001")));
+    }
+
+    #[test]
+    fn a_mug_in_inches_is_warned_about_and_a_metre_object_is_not() {
+        let mug_inches = bounding_diagonal(&[[0.0; 3], [4.7, 3.5, 3.9]]);
+        assert_eq!(unstated_size_refusal(mug_inches), None);
+        assert!(unit_warning(mug_inches).is_some_and(|w| w.contains("0.0254") && w.contains("7.04 m across")));
+        // A dataset's object normalized to the unit cube is taken as it is.
+        assert_eq!(unit_warning(bounding_diagonal(&[[0.0; 3], [1.0; 3]])), None);
     }
 
     #[test]

@@ -165,6 +165,12 @@ impl Scale {
         Scale { factor, stated: true }
     }
 
+    /// True when `warning` is the unit warning of an object `diagonal_m` across and
+    /// this scale was stated: the user said which unit the file is in.
+    fn answers(&self, warning: &str, diagonal_m: f64) -> bool {
+        self.stated && modal_mesh::unit_warning(diagonal_m).is_some_and(|w| w == warning)
+    }
+
     /// The refusal of an object `diagonal_m` across under this scale, if any.
     fn check(&self, diagonal_m: f64) -> Result<(), PrecomputeError> {
         match modal_mesh::unstated_size_refusal(diagonal_m).filter(|_| !self.stated) {
@@ -206,7 +212,7 @@ pub(crate) fn load_mesh_sized(
             if surface.sheet_thickness.is_some() {
                 report.drop_open_warning();
             }
-            warnings.extend(report.warnings.iter().cloned());
+            warnings.extend(report.warnings.iter().filter(|w| !scale.answers(w, report.diagonal_m)).cloned());
             let mut options = surface.tet_options();
             match level {
                 Some(LevelSize::Cell(c)) => options.cell = Some(c),
@@ -251,7 +257,7 @@ pub(crate) fn load_mesh_sized(
             let mesh = modal_mesh::read_mesh(path, factor)?;
             let diagonal_m = modal_mesh::bounding_diagonal(&mesh.nodes);
             scale.check(diagonal_m)?;
-            warnings.extend(modal_mesh::unit_warning(diagonal_m));
+            warnings.extend(modal_mesh::unit_warning(diagonal_m).filter(|w| !scale.answers(w, diagonal_m)));
             mesh
         }
         MeshSource::Memory { mesh, .. } => {

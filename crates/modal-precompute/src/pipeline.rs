@@ -132,6 +132,10 @@ pub enum Stage {
     Solve(String),
     /// Writing the bank to the cache.
     Store,
+    /// A warning about the input (a mesh repair, a size that suggests another unit),
+    /// said as soon as the mesh is read so the user can stop a long solve; it is in
+    /// [`Outcome::warnings`] too, and may come again for each discretization level.
+    Warning(String),
     /// Starting discretization level `index` (0: the first) for the error estimate,
     /// its element sizes × `size_factor` relative to the default.
     Level {
@@ -204,6 +208,7 @@ pub(crate) fn assemble_and_analyze(
         .map(|limit_bytes| TetBudget { limit_bytes, vector_bytes_per_dof });
     let scale = Scale { factor: request.scale, stated: request.scale_stated };
     let loaded = load_mesh_sized(&request.source, scale, &request.surface_meshing(), level, budget)?;
+    loaded.warnings.iter().for_each(|w| progress(Stage::Warning(w.clone())));
     let mesh = modal_fem::prepare_mesh(&loaded.mesh, request.order)?;
     // Mid-edge nodes belong to the part of their edge's corners.
     let part_of_node = extend_parts(&mesh, &loaded.part_of_node);
