@@ -398,6 +398,20 @@ fn a_file_in_millimetres_is_refused_at_once_and_solved_with_its_scale() {
 }
 
 #[test]
+fn a_bank_silent_in_the_band_is_said_after_one_level() {
+    // A 40 mm steel block rings above 20 kHz: the first level shows the band empty,
+    // and finer levels could only add minutes (a 6 mm bead went on to level 2).
+    let dir = temp_dir();
+    let obj = std::fs::File::create(dir.path().join("block.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(0.04, 0.02, 0.016), obj).unwrap();
+    let args = ["precompute", "block.obj", "-o", "b.bank", "--no-cache", "--material", "steel", "--json"];
+    let run = modal(dir.path(), &args).ok();
+    assert_eq!(frequencies(&run.json()).len(), 0);
+    assert!(run.stderr.contains("the bank is silent"), "{}", run.stderr);
+    assert!(!run.stderr.contains("level 1"), "no second level for a silent bank: {}", run.stderr);
+}
+
+#[test]
 fn surface_options_on_a_tet_mesh_are_named_not_dropped() {
     let dir = temp_dir();
     let bar = example("bar_p1.msh");
