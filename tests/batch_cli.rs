@@ -129,6 +129,7 @@ fn results(catalogue: &Value) -> Value {
         let e = e.as_object_mut().unwrap();
         assert!(e.remove("seconds").is_some_and(|s| s.as_f64().is_some_and(|s| s >= 0.0)));
         assert!(e.remove("cached").is_some_and(|c| c.is_boolean()));
+        assert!(e.remove("warnings").is_some_and(|w| w.is_array()));
     }
     c
 }
@@ -201,6 +202,15 @@ fn three_parallel_shards_on_one_cache_equal_the_unsharded_run() {
     for e in entries(&unsharded) {
         assert_eq!(e["status"], "ok");
         assert_eq!(e["modes"], 4);
+        // Mass and size, for a library's check that each file was read in its unit.
+        let i: f64 = e["path"].as_str().unwrap()[10..12].parse().unwrap();
+        let size = [0.12 + 0.01 * i, 0.06, 0.04];
+        let diagonal = size.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!((e["size_m"].as_f64().unwrap() / diagonal - 1.0).abs() < 1e-9, "{e}");
+        let density = e["mass_kg"].as_f64().unwrap() / size.iter().product::<f64>();
+        assert!([7850.0, 2600.0, 2700.0].iter().any(|d| (density / d - 1.0).abs() < 1e-9), "{e}");
+        assert!(e["warnings"].to_string().contains("no error estimate"), "{e}");
+        assert!(!e["warnings"].to_string().contains("--scale"), "{e}");
         let bank = e["bank"].as_str().unwrap();
         let (a, b) = (d.join("sharded").join(bank), d.join("whole").join(bank));
         // Bit for bit apart from the wall-clock timings recorded in the bank.

@@ -50,6 +50,18 @@ pub struct CatalogueEntry {
     /// the output directory) instead of solved in this run.
     #[serde(default)]
     pub cached: bool,
+    /// The body's mass \[kg\]; `null` when the asset failed. With `size_m`, the
+    /// check a library needs that every file was read in its unit (a 12 cm mug
+    /// written in inches weighs 24 t).
+    #[serde(default)]
+    pub mass_kg: Option<f64>,
+    /// The body's size: its bounding-box diagonal \[m\]; `null` when the asset failed.
+    #[serde(default)]
+    pub size_m: Option<f64>,
+    /// This run's warnings about the asset, as printed on stderr. A bank reused
+    /// (`cached`) carries only the warning its size gives, judged from the bank.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl CatalogueEntry {
@@ -62,9 +74,10 @@ impl CatalogueEntry {
         (&self.path, self.bank.as_deref(), self.hash.as_deref(), &self.status)
     }
 
-    /// The entry without the fields that describe the run (`seconds`, `cached`).
+    /// The entry without the fields that describe the run (`seconds`, `cached`,
+    /// `warnings`: a reused bank keeps only its size warning).
     pub fn result(&self) -> CatalogueEntry {
-        CatalogueEntry { seconds: 0.0, cached: false, ..self.clone() }
+        CatalogueEntry { seconds: 0.0, cached: false, warnings: Vec::new(), ..self.clone() }
     }
 }
 
@@ -296,6 +309,9 @@ mod tests {
             seconds,
             status: status.into(),
             cached: false,
+            mass_kg: ok.then_some(0.25),
+            size_m: ok.then_some(0.1),
+            warnings: Vec::new(),
         }
     }
 

@@ -138,17 +138,27 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
     });
     let seconds = start.elapsed().as_secs_f64();
     let entry = match outcome {
-        Ok(Solved { bank, transfer_modes, cached }) => CatalogueEntry {
-            path: asset.path.clone(),
-            bank: Some(asset.bank.clone()),
-            hash: Some(bank.info.input_hash.clone()),
-            modes: bank.frequencies_hz.len(),
-            first_frequency_hz: bank.frequencies_hz.first().copied(),
-            transfer_modes,
-            seconds,
-            status: "ok".into(),
-            cached,
-        },
+        Ok(Solved { bank, transfer_modes, cached }) => {
+            let size_m = modal_mesh::bounding_diagonal(&bank.surface.positions);
+            // A reused bank's file was not read again, but its size still says whether
+            // the file was in metres (a solve says so when it reads the file).
+            let size_warning = modal_mesh::unit_warning(size_m).filter(|_| cached && !request.scale_stated);
+            warnings.extend(size_warning.map(|w| format!("{}: {w}", asset.path)));
+            CatalogueEntry {
+                path: asset.path.clone(),
+                bank: Some(asset.bank.clone()),
+                hash: Some(bank.info.input_hash.clone()),
+                modes: bank.frequencies_hz.len(),
+                first_frequency_hz: bank.frequencies_hz.first().copied(),
+                transfer_modes,
+                seconds,
+                status: "ok".into(),
+                cached,
+                mass_kg: Some(bank.mass.mass_kg),
+                size_m: Some(size_m),
+                warnings: warnings.clone(),
+            }
+        }
         Err(status) => CatalogueEntry {
             path: asset.path.clone(),
             bank: None,
@@ -159,6 +169,9 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
             seconds,
             status,
             cached: false,
+            mass_kg: None,
+            size_m: None,
+            warnings: warnings.clone(),
         },
     };
     (entry, warnings)
