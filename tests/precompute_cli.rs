@@ -378,6 +378,17 @@ fn a_file_in_millimetres_is_refused_at_once_and_solved_with_its_scale() {
                 .concat(),
         )
     };
+    // A block of 4.7 x 3.5 x 3.9 (a mug's size in inches) is solved, with a warning
+    // said as the file is read, before the solve, and no warning once a scale is stated.
+    let obj = std::fs::File::create(dir.path().join("block_in.obj")).unwrap();
+    modal_tetra::write_obj(&modal_tetra::shapes::cuboid(4.7, 3.5, 3.9), obj).unwrap();
+    let args = ["precompute", "block_in.obj", "-o", "i.bank", "--no-cache", "--material", "steel"];
+    let inches =
+        modal(dir.path(), &[&args[..], &["--cell", "1", "--modes", "2", "--accuracy", "off"]].concat()).ok();
+    let said = inches.stderr.find("7.04 m across").expect("a size warning");
+    assert!(said < inches.stderr.find("assembling K and M").unwrap(), "{}", inches.stderr);
+    let stated = [&args[..], &["--cell", "1", "--modes", "2", "--accuracy", "off", "--scale", "1"]].concat();
+    assert!(!modal(dir.path(), &stated).ok().stderr.contains("m across"));
     let refused = precompute("block_mm.obj", &[]).fails_with("--scale 0.001");
     assert!(refused.stderr.contains("47.5 m across"), "{}", refused.stderr);
     assert!(!dir.path().join("b.bank").exists(), "no output for a refused file");
