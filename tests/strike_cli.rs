@@ -109,3 +109,19 @@ fn bad_strikes_fail_cleanly_without_output() {
     assert!(!dir.path().join("x.wav").exists());
     assert!(files_in(dir.path()).iter().all(|f| !f.ends_with(".tmp")));
 }
+
+#[test]
+fn a_strike_that_rounds_to_silence_says_so() {
+    // A body heavy for its tap (a 35 kg beam, or a file read in the wrong unit)
+    // rounds to zeros in 16-bit PCM: said, with the body's mass and what to change.
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let faint = modal(dir.path(), &["strike", "bar.bank", "-o", "faint.wav", "--impulse", "1e-9"]).ok();
+    assert!(wav_samples(&dir.path().join("faint.wav")).iter().all(|&s| s == 0));
+    assert!(faint.stderr.contains("below one step of 16-bit PCM"), "{}", faint.stderr);
+    assert!(faint.stderr.contains("--impulse"), "{}", faint.stderr);
+    let normalized = ["strike", "bar.bank", "-o", "n.wav", "--impulse", "1e-9", "--normalize"];
+    assert!(!modal(dir.path(), &normalized).ok().stderr.contains("16-bit"));
+    let heard = modal(dir.path(), &["strike", "bar.bank", "-o", "heard.wav"]).ok();
+    assert!(!heard.stderr.contains("16-bit"), "{}", heard.stderr);
+}
