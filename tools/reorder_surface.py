@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The same OBJ surface written another way, for the order and crack checks in BENCHMARKS.md
-("One surface, one mesh: a canonical order"). Standard library only.
+"""The same OBJ surface written another way, for the order, crack and unit checks in
+BENCHMARKS.md ("One surface, one mesh: a canonical order"; "Files in other units").
+Standard library only.
 
   reorder_surface.py shuffle IN.obj OUT.obj SEED
       vertices and faces in a random order, each triangle starting at a random corner
@@ -9,6 +10,9 @@
       an unwelded soup of triangles, each copy of a corner moved by up to REL x the
       bounding-box diagonal in each coordinate (per-face transforms, single precision);
       --half-twice also writes every other face again, reversed
+  reorder_surface.py scale IN.obj OUT.obj FACTOR
+      every coordinate times FACTOR: a file in metres written as millimetres is FACTOR 1000,
+      centimetres 100, inches 39.37
 """
 import argparse
 import random
@@ -65,16 +69,18 @@ def crack(vertices, faces, rel, half_twice, rng):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("how", choices=["shuffle", "crack"])
+    ap.add_argument("how", choices=["shuffle", "crack", "scale"])
     ap.add_argument("input")
     ap.add_argument("output")
-    ap.add_argument("amount", type=float, help="SEED for shuffle, REL for crack")
+    ap.add_argument("amount", type=float, help="SEED for shuffle, REL for crack, FACTOR for scale")
     ap.add_argument("--half-twice", action="store_true")
     ap.add_argument("--seed", type=int, default=5)
     a = ap.parse_args()
     vertices, faces = read_obj(a.input)
     if a.how == "shuffle":
         vertices, faces = shuffle(vertices, faces, random.Random(int(a.amount)))
+    elif a.how == "scale":
+        vertices = [[x * a.amount for x in v] for v in vertices]
     else:
         vertices, faces = crack(vertices, faces, a.amount, a.half_twice, random.Random(a.seed))
     write_obj(a.output, vertices, faces)
