@@ -134,7 +134,8 @@ pub enum Stage {
     Store,
     /// A warning about the input (a mesh repair, a size that suggests another unit),
     /// said as soon as the mesh is read so the user can stop a long solve; it is in
-    /// [`Outcome::warnings`] too, and may come again for each discretization level.
+    /// [`Outcome::warnings`] too. A finer discretization level says its own; the coarse
+    /// level of the error estimate says none (its mesh is not the bank's).
     Warning(String),
     /// Starting discretization level `index` (0: the first) for the error estimate,
     /// its element sizes × `size_factor` relative to the default.
