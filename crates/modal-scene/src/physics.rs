@@ -124,6 +124,10 @@ pub(crate) struct World {
     pre_step: Vec<([f64; 3], [f64; 3], [f64; 3])>,
     /// Per object: rolling-resistance lever arm [m].
     rolling_m: Vec<f64>,
+    /// Per object: the centre of mass of a fixed body (its scene position), which
+    /// rapier does not know: a fixed body carries no mass properties, so its
+    /// `center_of_mass` is the mesh frame's origin (a generated box's corner).
+    fixed_com: Vec<Option<[f64; 3]>>,
     /// Per object: scratch, normal impulse of the last step [N·s].
     normal_ns: Vec<f64>,
     /// Per object: thinnest extent of its collider (rapier's CCD thickness) [m].
@@ -253,6 +257,8 @@ impl World {
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
+        let fixed_com =
+            scene.objects.iter().map(|o| (o.body != BodyKind::Dynamic).then_some(o.position_m)).collect();
         let normal_ns = vec![0.0; bodies.len()];
         Ok(World {
             world,
@@ -260,6 +266,7 @@ impl World {
             sides,
             pre_step,
             rolling_m,
+            fixed_com,
             normal_ns,
             ccd_thickness_m,
             gravity: scene.gravity_m_s2,
@@ -268,7 +275,7 @@ impl World {
 
     /// World position of object `i`'s centre of mass [m].
     pub fn center_of_mass(&self, i: usize) -> [f64; 3] {
-        d3(self.world.bodies[self.bodies[i]].center_of_mass())
+        self.fixed_com[i].unwrap_or_else(|| d3(self.world.bodies[self.bodies[i]].center_of_mass()))
     }
 
     /// Rotates a world vector into object `i`'s mesh frame (current pose).

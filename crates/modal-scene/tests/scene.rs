@@ -40,6 +40,11 @@ fn both_bodies_of_a_contact_ring_at_their_own_frequencies() {
     let scene = Scene::from_toml_str(BALL_ON_SLAB, Path::new(".")).expect("scene");
     let out = render(&scene, &mut slab_provider(), &RenderOptions::default()).expect("render");
     assert!(out.report.objects.iter().all(|o| o.impacts >= 1), "{:?}", out.report.objects);
+    // The fixed slab is where the scene put its centre of mass (its mesh's corner is
+    // at the origin of its frame, which rapier reports for a body without mass), and
+    // the listener hears it from there.
+    let slab = out.report.objects[1].final_position_m;
+    assert!(slab.iter().zip([0.0, -0.02, 0.0]).all(|(a, b)| (a - b).abs() < 1e-7), "{slab:?}");
     let spectrum = common::Spectrum::after_onset(&out.channels[0], 8192, 16000.0);
     let (level, floor) = (|f| spectrum.level(f), spectrum.median());
     // The slab's 2300 Hz mode decays within ~20 ms (wood, β ω²/2 ≈ 210/s):
