@@ -212,6 +212,43 @@ pub(crate) fn check_ground_clearance(scene: &Scene, banks: &[Arc<ModeBank>]) -> 
     Ok(())
 }
 
+/// Two objects whose colliders overlap by more than this at the start are refused [m]:
+/// rapier would push them apart at once (an impact out of nothing) or leave them
+/// interlocked, silently (a box set 2 mm into another stayed 1.6 mm inside).
+pub const START_OVERLAP_TOLERANCE_M: f64 = 1e-4;
+
+/// Rejects two objects (not both fixed) whose colliders overlap at the start, as
+/// [`check_ground_clearance`] does for the ground. Pairs parry cannot query are skipped.
+fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scene) -> Result<(), SceneError> {
+    let colliders = |i: usize| world.bodies[bodies[i]].colliders().iter().map(|h| &world.colliders[*h]);
+    let fixed = |i: usize| !world.bodies[bodies[i]].is_dynamic();
+    for i in 0..bodies.len() {
+        for j in (i + 1..bodies.len()).filter(|&j| !(fixed(i) && fixed(j))) {
+            for (a, b) in colliders(i).flat_map(|a| colliders(j).map(move |b| (a, b))) {
+                if !a.compute_aabb().intersects(&b.compute_aabb()) {
+                    continue;
+                }
+                let contact =
+                    rapier3d::parry::query::contact(a.position(), a.shape(), b.position(), b.shape(), 0.0);
+                let Ok(Some(contact)) = contact else { continue };
+                if -contact.dist as f64 > START_OVERLAP_TOLERANCE_M {
+                    return Err(SceneError::invalid(
+                        format!("objects[{j}].position"),
+                        format!(
+                            "object '{}' overlaps object '{}' by {:.4} m at the start (a dynamic body collides \
+                             as its convex hull unless collider = \"decomposition\"): move them apart",
+                            scene.object_name(j),
+                            scene.object_name(i),
+                            -contact.dist
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 impl World {
     /// Builds bodies and colliders for all objects and the ground.
     pub fn new(scene: &Scene, banks: &[Arc<ModeBank>]) -> Result<World, SceneError> {
@@ -256,6 +293,7 @@ impl World {
             });
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
+        check_overlaps(&world, &bodies, scene)?;
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
         let fixed_com =
             scene.objects.iter().map(|o| (o.body != BodyKind::Dynamic).then_some(o.position_m)).collect();

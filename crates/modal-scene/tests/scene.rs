@@ -154,6 +154,37 @@ position = [0.0, 0.01, 0.0]
 }
 
 #[test]
+fn objects_overlapping_at_the_start_are_an_error_and_touching_ones_are_not() {
+    // Two 4 cm blocks, the upper one set `gap` above the lower one's top face.
+    let stack = |gap: f64| {
+        let text = format!(
+            "duration = 0.1\nsample_rate = 16000\n[ground]\n\
+             [[objects]]\nname = \"low\"\nmesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
+             material = \"wood\"\nposition = [0.0, 0.01, 0.0]\n\
+             [[objects]]\nname = \"up\"\nmesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
+             material = \"wood\"\nposition = [0.005, {}, 0.0]\n",
+            0.03 + gap
+        );
+        let scene = Scene::from_toml_str(&text, Path::new(".")).expect("scene parses");
+        let mut p = InMemoryProvider::new();
+        p.insert("box", common::block([0.04, 0.02, 0.04], &[2000.0]));
+        render(&scene, &mut p, &RenderOptions::default())
+    };
+    match stack(-0.002) {
+        Err(e @ SceneError::Invalid { .. }) => {
+            let m = e.to_string();
+            assert!(
+                m.contains("objects[1].position") && m.contains("'up' overlaps object 'low' by 0.0020 m"),
+                "{m}"
+            );
+        }
+        other => panic!("expected an overlap error, got {other:?}"),
+    }
+    stack(0.0).expect("blocks exactly touching render");
+    stack(-0.5 * modal_scene::START_OVERLAP_TOLERANCE_M).expect("an overlap within the tolerance renders");
+}
+
+#[test]
 fn demo_scene_parses_with_generated_meshes() {
     let demo = Scene::demo();
     assert!(demo.objects.len() >= 3);
