@@ -169,6 +169,9 @@ fn assert_rings(dir: &std::path::Path, name: &str, scene: &str) {
     assert!(object["impacts"].as_u64().unwrap() >= 1, "{object}");
     assert!(object["modes_synthesized"].as_u64().unwrap() > 0, "{object}");
     assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
+    // The whole render (a bank solved here) is slower than its per-render stages.
+    let (stages, whole) = (report["real_time_factor"].as_f64(), report["whole_real_time_factor"].as_f64());
+    assert!(whole.unwrap() < stages.unwrap(), "{report}");
 }
 
 #[test]
