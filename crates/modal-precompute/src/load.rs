@@ -160,11 +160,6 @@ pub struct Scale {
 }
 
 impl Scale {
-    /// A scale the caller stated.
-    pub fn stated(factor: f64) -> Self {
-        Scale { factor, stated: true }
-    }
-
     /// True when `warning` is the unit warning of an object `diagonal_m` across and
     /// this scale was stated: the user said which unit the file is in.
     fn answers(&self, warning: &str, diagonal_m: f64) -> bool {
