@@ -30,6 +30,7 @@ mod output;
 mod physics;
 mod provider;
 mod render;
+mod report;
 pub mod roughness;
 mod spec;
 pub mod stand_in;
