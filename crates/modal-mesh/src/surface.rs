@@ -52,10 +52,7 @@ fn drop_coincident_faces(mesh: &TetMesh, on_boundary: &mut [bool]) {
     nodes.sort_unstable();
     nodes.dedup();
     let point = |n: usize| mesh.nodes[n];
-    let (lo, hi) = nodes.iter().fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), &n| {
-        let p = point(n);
-        ([0, 1, 2].map(|k| lo[k].min(p[k])), [0, 1, 2].map(|k| hi[k].max(p[k])))
-    });
+    let (lo, hi) = crate::bounding_box(nodes.iter().map(|&n| point(n)));
     let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     let tol = COINCIDENT_NODE_TOLERANCE * diagonal;
     if !(tol > 0.0 && tol.is_finite()) {

@@ -243,14 +243,7 @@ struct NearestGrid<'a> {
 
 impl<'a> NearestGrid<'a> {
     fn new(points: &'a [[f64; 3]]) -> Self {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in points {
-            for c in 0..3 {
-                lo[c] = lo[c].min(p[c]);
-                hi[c] = hi[c].max(p[c]);
-            }
-        }
+        let (lo, hi) = modal_mesh::bounding_box(points.iter().copied());
         let extent: f64 = (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt().max(1e-12);
         // Surface points: about √n cells along the diagonal puts a few points per
         // occupied cell.

@@ -118,14 +118,7 @@ fn sphere_of(bank: &ModeBank) -> Option<([f64; 3], f64)> {
     if p.len() < 12 {
         return None;
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for x in p {
-        for c in 0..3 {
-            lo[c] = lo[c].min(x[c]);
-            hi[c] = hi[c].max(x[c]);
-        }
-    }
+    let (lo, hi) = bank.surface.bounding_box();
     let centre: [f64; 3] = std::array::from_fn(|c| 0.5 * (lo[c] + hi[c]));
     let dist = |x: &[f64; 3]| (0..3).map(|c| (x[c] - centre[c]).powi(2)).sum::<f64>().sqrt();
     let mean = p.iter().map(dist).sum::<f64>() / p.len() as f64;

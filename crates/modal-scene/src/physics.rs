@@ -165,14 +165,7 @@ pub(crate) fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
 
 /// Default Hertz radius: half the smallest bounding-box extent of the surface.
 fn default_contact_radius(bank: &ModeBank) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in &bank.surface.positions {
-        for c in 0..3 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
+    let (lo, hi) = bank.surface.bounding_box();
     (0..3).map(|c| hi[c] - lo[c]).fold(f64::INFINITY, f64::min).max(1e-6) * 0.5
 }
 

@@ -122,13 +122,5 @@ pub fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     if points.is_empty() {
         return ([0.0; 3], [0.0; 3]);
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for c in 0..3 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
-    (lo, hi)
+    crate::bounding_box(points.iter().copied())
 }
