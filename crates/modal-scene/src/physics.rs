@@ -213,12 +213,24 @@ pub const START_OVERLAP_TOLERANCE_M: f64 = 1e-4;
 /// Rejects two objects (not both fixed) whose colliders overlap at the start, as
 /// [`check_ground_clearance`] does for the ground. Pairs parry cannot query are skipped.
 fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scene) -> Result<(), SceneError> {
-    let colliders = |i: usize| world.bodies[bodies[i]].colliders().iter().map(|h| &world.colliders[*h]);
+    // Each collider with its bounding box, computed once (a fine hull's box reads every vertex).
+    let colliders: Vec<Vec<(&Collider, Aabb)>> = bodies
+        .iter()
+        .map(|b| {
+            world.bodies[*b]
+                .colliders()
+                .iter()
+                .map(|h| &world.colliders[*h])
+                .map(|c| (c, c.compute_aabb()))
+                .collect()
+        })
+        .collect();
     let fixed = |i: usize| !world.bodies[bodies[i]].is_dynamic();
     for i in 0..bodies.len() {
         for j in (i + 1..bodies.len()).filter(|&j| !(fixed(i) && fixed(j))) {
-            for (a, b) in colliders(i).flat_map(|a| colliders(j).map(move |b| (a, b))) {
-                if !a.compute_aabb().intersects(&b.compute_aabb()) {
+            let pairs = colliders[i].iter().flat_map(|a| colliders[j].iter().map(move |b| (a, b)));
+            for ((a, a_box), (b, b_box)) in pairs {
+                if !a_box.intersects(b_box) {
                     continue;
                 }
                 let contact =
