@@ -96,12 +96,12 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     let start = Instant::now();
     let on_event = |event: Event<'_>| match event {
         Event::Started { asset } => bar.set_message(asset.path.clone()),
-        Event::Finished { entry, warnings, .. } => {
+        Event::Finished { entry, .. } => {
             bar.inc(1);
             // Read before `suspend`, which holds the bar's lock while its closure runs.
             let (done, total, eta) = (bar.position(), bar.length().unwrap_or(0), bar.eta().as_secs());
             bar.suspend(|| {
-                warnings.iter().for_each(|w| warn(w));
+                entry.warnings.iter().for_each(|w| warn(w));
                 if !entry.is_ok() {
                     warn(&format!("{} failed: {}", entry.path, entry.status));
                 }

@@ -59,10 +59,9 @@ pub enum Event<'a> {
     Finished {
         /// The asset.
         asset: &'a Asset,
-        /// Its catalogue entry.
+        /// Its catalogue entry, with the warnings for the user (mesh fixes, a
+        /// damaged cache entry, ...).
         entry: &'a CatalogueEntry,
-        /// Warnings for the user (mesh fixes, a damaged cache entry, ...).
-        warnings: &'a [String],
     },
 }
 
@@ -88,7 +87,7 @@ pub fn run_batch(
         let i = next.fetch_add(1, Ordering::Relaxed);
         let Some(asset) = assets.get(i) else { break };
         on_event(Event::Started { asset });
-        let (entry, warnings) = run_asset(asset, options);
+        let entry = run_asset(asset, options);
         {
             let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
             s.done.push(entry.clone());
@@ -100,7 +99,7 @@ pub fn run_batch(
                 s.write_error.get_or_insert(e);
             }
         }
-        on_event(Event::Finished { asset, entry: &entry, warnings: &warnings });
+        on_event(Event::Finished { asset, entry: &entry });
     };
     let jobs = options.jobs.clamp(1, assets.len().max(1));
     std::thread::scope(|scope| {
@@ -119,7 +118,7 @@ pub fn run_batch(
 }
 
 /// Runs one asset; never fails: errors (and panics) become the entry's status.
-pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<String>) {
+pub fn run_asset(asset: &Asset, options: &BatchOptions) -> CatalogueEntry {
     let start = Instant::now();
     let mut request = asset.request.clone();
     request.threads = options.threads;
@@ -137,7 +136,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
         Err(format!("internal error (please report): {what}"))
     });
     let seconds = start.elapsed().as_secs_f64();
-    let entry = match outcome {
+    match outcome {
         Ok(Solved { bank, transfer_modes, cached }) => {
             let size_m = modal_mesh::bounding_diagonal(&bank.surface.positions);
             // A reused bank's file was not read again, but its size still says whether
@@ -156,7 +155,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
                 cached,
                 mass_kg: Some(bank.mass.mass_kg),
                 size_m: Some(size_m),
-                warnings: warnings.clone(),
+                warnings,
             }
         }
         Err(status) => CatalogueEntry {
@@ -171,10 +170,9 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> (CatalogueEntry, Vec<
             cached: false,
             mass_kg: None,
             size_m: None,
-            warnings: warnings.clone(),
+            warnings,
         },
-    };
-    (entry, warnings)
+    }
 }
 
 /// An asset's bank as written to the output directory.
