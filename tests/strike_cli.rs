@@ -118,7 +118,7 @@ fn a_strike_that_rounds_to_silence_says_so() {
     bar_bank(dir.path());
     let faint = modal(dir.path(), &["strike", "bar.bank", "-o", "faint.wav", "--impulse", "1e-9"]).ok();
     assert!(wav_samples(&dir.path().join("faint.wav")).iter().all(|&s| s == 0));
-    assert!(faint.stderr.contains("below one step of 16-bit PCM"), "{}", faint.stderr);
+    assert!(faint.stderr.contains("below half a step of 16-bit PCM"), "{}", faint.stderr);
     assert!(faint.stderr.contains("--impulse"), "{}", faint.stderr);
     let normalized = ["strike", "bar.bank", "-o", "n.wav", "--impulse", "1e-9", "--normalize"];
     assert!(!modal(dir.path(), &normalized).ok().stderr.contains("16-bit"));

@@ -20,8 +20,6 @@ use super::output::{print_json, warn};
 /// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
 pub const DEFAULT_IMPULSE_NS: f64 = 0.01;
 
-/// One step of 16-bit PCM as a fraction of full scale: a quieter peak rounds to zeros.
-const PCM16_STEP: f64 = 1.0 / 32768.0;
 /// Longest automatic duration [s]; a fade-out ends sounds that ring longer.
 pub const AUTO_DURATION_CAP_S: f64 = 30.0;
 /// Level of `--normalize`: peak at −1 dBFS.
@@ -185,13 +183,13 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         warn(&format!("the bank holds no mode: {} is silent", args.out.display()));
     } else if !args.float
         && !args.normalize
-        && report.peak < PCM16_STEP
+        && report.peak < modal_synth::PCM16_SMALLEST_NONZERO
         && stats.modes_skipped < stats.modes_total
     {
         // A heavy body (a 35 kg beam, or a file read in the wrong unit) barely moves under
         // the default tap: say so rather than write zeros that look like a bug.
         warn(&format!(
-            "the peak is {:.1e} of full scale, below one step of 16-bit PCM: {} is silent; the body weighs {:.3e} kg, \
+            "the peak is {:.1e} of full scale, below half a step of 16-bit PCM: {} is silent; the body weighs {:.3e} kg, \
              so strike harder (--impulse) or use --normalize or --float",
             report.peak,
             args.out.display(),

@@ -58,4 +58,4 @@ pub use voice::{
     ExcitedMode, ImpactPoint, ModalVoice, VoiceStats, ABSOLUTE_FLOOR, BLOCK, MAX_OUTPUT, PARALLEL_MIN_MODES,
     REANCHOR_BLOCKS,
 };
-pub use wav::{write_wav, WavFormat, WavGain, WavReport, DEFAULT_WAV_GAIN};
+pub use wav::{write_wav, WavFormat, WavGain, WavReport, DEFAULT_WAV_GAIN, PCM16_SMALLEST_NONZERO};

@@ -47,6 +47,10 @@ impl Default for WavGain {
 /// Frames per block of the 16-bit writer.
 const PCM_BLOCK_FRAMES: usize = 16_384;
 
+/// The smallest |sample| (full scale = 1) that [`pcm16`] does not write as 0: it
+/// rounds `x · 32767` half away from zero.
+pub const PCM16_SMALLEST_NONZERO: f64 = 0.5 / 32767.0;
+
 /// A sample (full scale = 1) as 16-bit PCM: clamped to ±1, times 32767,
 /// rounded half away from zero — `(x.clamp(-1, 1) · 32767).round()` exactly,
 /// without the libm call: truncation is exact, and so is the remainder
@@ -204,5 +208,13 @@ mod tests {
         for x in xs {
             assert_eq!(pcm16(x), pcm16_reference(x), "x = {x:e}");
         }
+    }
+
+    #[test]
+    fn the_smallest_nonzero_sample_is_where_pcm16_leaves_zero() {
+        let at = PCM16_SMALLEST_NONZERO;
+        assert_eq!(pcm16(at), 1);
+        assert_eq!(pcm16(-at), -1);
+        assert_eq!(pcm16(f64::from_bits(at.to_bits() - 1)), 0);
     }
 }
