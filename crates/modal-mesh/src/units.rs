@@ -14,7 +14,7 @@ pub const LARGEST_PLAIN_DIAGONAL_M: f64 = 20.0;
 /// The largest bounding-box diagonal [m] taken as metres without a warning:
 /// a file in centimetres or inches of an object of 10–20 cm, or in millimetres
 /// of a bead, lands between this and [`LARGEST_PLAIN_DIAGONAL_M`] (a 12 cm mug
-/// in inches: 5.3 m, 24 t, its modes 40× too low), where real objects are rare
+/// in inches: 6.9 m, 24 t, its modes 40× too low), where real objects are rare
 /// but exist (a 3 m beam), so it is said, not refused.
 pub const LARGEST_UNREMARKED_DIAGONAL_M: f64 = 2.5;
 
