@@ -201,3 +201,27 @@ fn a_mesh_in_millimetres_is_refused_until_the_scene_gives_its_scale() {
     assert!(!dir.path().join("mm.wav").exists());
     assert_rings(dir.path(), "scaled", &one_object_dropped(&format!("{bar}\nscale = 0.001")));
 }
+
+#[test]
+fn scenes_at_44_1_and_48_khz_share_one_bank() {
+    // Both rates' Nyquist frequencies round up to the 24 kHz band, so the
+    // second render reads the first one's bank from the cache; both ring.
+    let dir = temp_dir();
+    let bar =
+        "mesh = { generate = \"box\", size = [0.2, 0.02, 0.01], element_size = 0.01 }\nmaterial = \"wood\"";
+    let scene = one_object_dropped(bar);
+    for (rate, solved, cached) in [(44100, 1, 0), (48000, 0, 1), (16000, 1, 0)] {
+        let name = format!("r{rate}");
+        std::fs::write(dir.path().join(format!("{name}.toml")), scene.replace("16000", &rate.to_string()))
+            .unwrap();
+        let args = ["render", &format!("{name}.toml"), "-o", &format!("{name}.wav"), "--json"];
+        let report = modal(dir.path(), &args).ok().json();
+        assert_eq!(
+            (report["banks_solved"].as_u64(), report["banks_cached"].as_u64()),
+            (Some(solved), Some(cached))
+        );
+        assert_eq!(report["sample_rate"].as_u64(), Some(rate), "{report}");
+        assert!(report["objects"][0]["modes_synthesized"].as_u64().unwrap() > 0, "{report}");
+        assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
+    }
+}

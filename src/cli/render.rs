@@ -334,8 +334,9 @@ impl PipelineProvider<'_> {
         pipeline.scale_stated = request.scale.is_some();
         pipeline.surface.sheet_thickness = request.sheet_thickness;
         pipeline.order = request.order.unwrap_or(2);
-        // No modes above the scene's Nyquist frequency are worth solving for.
-        pipeline.max_freq_hz = request.max_frequency_hz;
+        // No modes above the scene's Nyquist frequency are worth solving for;
+        // rounded up to a standard band, so 44.1 and 48 kHz share a bank.
+        pipeline.max_freq_hz = request.band_to_solve_hz();
         pipeline.threads = self.threads;
         pipeline.memory_limit_bytes = self.memory_limit_bytes;
         pipeline

@@ -32,6 +32,42 @@ pub struct BankRequest {
     pub max_frequency_hz: f64,
 }
 
+/// The two mantissas of the standard solve bands: `{4, 6} kHz · 2^j`, the
+/// Nyquist frequencies of the 48 kHz family (8, 16, 24, 48, 96 kHz ... and
+/// 12 kHz between). Every standard rate's Nyquist frequency is one of them
+/// or at most 8.8 % below one (22.05 kHz, 44.1 kHz's, below 24 kHz).
+const BAND_MANTISSAS_HZ: [f64; 2] = [4000.0, 6000.0];
+
+impl BankRequest {
+    /// The band a bank is solved to [Hz]: the Nyquist frequency rounded up to
+    /// the next standard band (`{4, 6} kHz · 2^j`), so scenes at 44.1 and
+    /// 48 kHz (both 24 kHz), or 22.05 and 24 kHz, share one bank instead of
+    /// solving one per sample rate. The synthesizer plays only the modes
+    /// below its own Nyquist limit, so the few modes above it cost solve
+    /// time and nothing else.
+    pub fn band_to_solve_hz(&self) -> f64 {
+        standard_band_at_least(self.max_frequency_hz)
+    }
+}
+
+/// The smallest standard band `{4, 6} kHz · 2^j` not below `frequency_hz`
+/// (`frequency_hz` itself when it is not finite and positive: the
+/// pipeline's own check then refuses it).
+fn standard_band_at_least(frequency_hz: f64) -> f64 {
+    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+        return frequency_hz;
+    }
+    let octave = (frequency_hz / BAND_MANTISSAS_HZ[0]).log2().floor();
+    // The octave below, this one and the next bracket the answer whatever
+    // the rounding of `log2`.
+    let band = (-1..=1)
+        .flat_map(|shift| BAND_MANTISSAS_HZ.map(|m| m * (octave + f64::from(shift)).exp2()))
+        .filter(|&band| band >= frequency_hz)
+        .fold(f64::INFINITY, f64::min);
+    debug_assert!(band >= frequency_hz && band <= 1.5 * frequency_hz * (1.0 + 1e-12));
+    band
+}
+
 impl BankRequest {
     /// The request behind object `object` of `scene`.
     pub fn for_object(scene: &Scene, object: &ObjectSpec) -> Result<BankRequest, String> {
@@ -284,4 +320,39 @@ fn check_body(path: &str, bank: &ModeBank) -> Result<(), SceneError> {
         return bad("its centre of mass or inertia is not finite");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::standard_band_at_least;
+
+    #[test]
+    fn standard_rates_share_the_band_of_their_family() {
+        // (sample rate, band its scene's banks are solved to)
+        let cases = [
+            (8000, 4000.0),
+            (11025, 6000.0),
+            (16000, 8000.0),
+            (22050, 12000.0),
+            (24000, 12000.0),
+            (32000, 16000.0),
+            (44100, 24000.0),
+            (48000, 24000.0),
+            (88200, 48000.0),
+            (96000, 48000.0),
+            (192000, 96000.0),
+        ];
+        for (rate, band) in cases {
+            assert_eq!(standard_band_at_least(0.5 * f64::from(rate)), band, "{rate} Hz");
+        }
+        // Between the bands: the next one up, never more than 1.5 times the Nyquist frequency.
+        assert_eq!(standard_band_at_least(12000.5), 16000.0);
+        assert_eq!(standard_band_at_least(16000.5), 24000.0);
+        assert_eq!(standard_band_at_least(24000.5), 32000.0);
+        for nyquist in (4000..=96000).step_by(37) {
+            let band = standard_band_at_least(f64::from(nyquist));
+            assert!(band >= f64::from(nyquist) && band <= 1.5 * f64::from(nyquist), "{nyquist}: {band}");
+        }
+        assert!(standard_band_at_least(f64::NAN).is_nan());
+    }
 }
