@@ -226,3 +226,38 @@ fn gltf_files_without_modal_data_are_refused() {
     modal(dir.path(), &["precompute", "junk.glb", "-o", "x.bank"]).fails_with("not a valid glTF");
     assert!(!dir.path().join("x.wav").exists() && !dir.path().join("x.bank").exists());
 }
+
+#[test]
+fn a_stored_transfer_survives_the_gltf_round_trip() {
+    // The bank's acoustic transfer travels in the glTF's side data: striking,
+    // re-importing and rendering the .glb hear it as they do the .bank.
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    modal(dir.path(), &["radiation", "bar.bank", "--max-freq", "1200", "--store", "rad.bank"]).ok();
+    let report = modal(dir.path(), &["export", "rad.bank", "--gltf", "rad.glb", "--json"]).ok().json();
+    assert_eq!(report["gltf"]["radiation_modes"], 2, "{report}");
+    assert_eq!(
+        (report["gltf"]["modes"].as_u64(), report["gltf"]["skipped_modes"].as_u64()),
+        (Some(12), Some(0))
+    );
+    let strike = |bank: &str, out: &str| {
+        let run =
+            modal(dir.path(), &["strike", bank, "--at", "0.29,0.0,0.005", "--duration", "0.3", "-o", out])
+                .ok();
+        (run.stderr, std::fs::read(dir.path().join(out)).unwrap())
+    };
+    let (bank_log, from_bank) = strike("rad.bank", "bank.wav");
+    let (gltf_log, from_gltf) = strike("rad.glb", "gltf.wav");
+    assert!(!gltf_log.contains("no radiation data"), "{gltf_log}");
+    assert_eq!(bank_log.contains("no stored radiation"), gltf_log.contains("no stored radiation"));
+    assert_eq!(from_bank, from_gltf, "identical WAV bytes");
+    modal(dir.path(), &["precompute", "rad.glb", "-o", "again.bank"]).ok();
+    let original = std::fs::read(dir.path().join("rad.bank")).unwrap();
+    assert_eq!(std::fs::read(dir.path().join("again.bank")).unwrap(), original);
+    let info = modal(dir.path(), &["info", "rad.glb", "--json"]).ok().json();
+    assert!(info["modes"][0]["radiated_power_w"].as_f64().unwrap() > 0.0, "{info}");
+    // A glTF output must be named .glb: the file is binary.
+    modal(dir.path(), &["export", "rad.bank", "--gltf", "rad.gltf"]).fails_with("give it a .glb name");
+    modal(dir.path(), &["export", "rad.bank", "--gltf", "rad2.bank"]).fails_with("give it a .glb name");
+    assert!(!dir.path().join("rad.gltf").exists() && !dir.path().join("rad2.bank").exists());
+}

@@ -84,18 +84,36 @@ fn faust(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
 }
 
 fn gltf(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
+    // Binary glTF only: a `.gltf` name promises JSON, and any other name
+    // (`x.bank`) would be read back as something else.
+    let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    anyhow::ensure!(glb, "--gltf {}: the file is binary glTF; give it a .glb name", path.display());
     let name = args.bank.file_stem().map_or_else(|| "model".into(), |n| n.to_string_lossy().into_owned());
-    let bytes = modal_export::gltf::export_glb(bank, &name, true).context("--gltf")?;
-    write_file(path, |w| Ok(w.write_all(&bytes)?))?;
-    let line = format!(
-        "wrote {} (glTF, {}: {} modes on {} surface points, {} bytes)",
+    let radiation = super::listener::stored_radiation(&args.bank)?;
+    let glb = modal_export::gltf::export_glb(bank, radiation.as_ref(), &name, true).context("--gltf")?;
+    write_file(path, |w| Ok(w.write_all(&glb.bytes)?))?;
+    let modes = bank.mode_count() - glb.overdamped_left_out;
+    let mut line = format!(
+        "wrote {} (glTF, {}: {modes} modes on {} surface points",
         path.display(),
         modal_export::gltf::EXTENSION,
-        bank.mode_count(),
         bank.surface_node_count(),
-        bytes.len()
     );
-    Ok(json!({ "path": path.display().to_string(), "bytes": bytes.len(), "summary": line }))
+    if glb.radiation_modes > 0 {
+        line.push_str(&format!(", the acoustic transfer of {} in extras.modal", glb.radiation_modes));
+    }
+    if glb.overdamped_left_out > 0 {
+        line.push_str(&format!(", {} overdamped modes left out", glb.overdamped_left_out));
+    }
+    line.push_str(&format!(", {} bytes)", glb.bytes.len()));
+    Ok(json!({
+        "path": path.display().to_string(),
+        "bytes": glb.bytes.len(),
+        "modes": modes,
+        "skipped_modes": glb.overdamped_left_out,
+        "radiation_modes": glb.radiation_modes,
+        "summary": line,
+    }))
 }
 
 pub fn run(args: ExportArgs) -> Result<()> {

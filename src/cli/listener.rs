@@ -144,10 +144,12 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
 }
 
 /// The radiation table stored in the bank file at `path` (`None` for banks
-/// without one and for glTF files, which carry no radiation).
+/// without one; a glTF's is in its exact side data, `extras.modal`).
 pub fn stored_radiation(path: &Path) -> Result<Option<modal_bank::RadiationTable>> {
     if modal_export::gltf::is_gltf_path(path) {
-        return Ok(None);
+        let imported = modal_export::gltf::import_gltf_file(path)
+            .with_context(|| format!("cannot load bank {}", path.display()))?;
+        return Ok(imported.radiation);
     }
     let (_, table) = ModeBank::load_with_radiation(path)
         .with_context(|| format!("cannot load bank {}", path.display()))?;

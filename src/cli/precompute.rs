@@ -211,8 +211,12 @@ fn import_gltf(args: &PrecomputeArgs) -> Result<()> {
         warn("the glTF already holds modes: material flags are ignored (use `modal retune` to change them)");
     }
     let bank = super::bank_cmds::load_bank(&args.mesh)?;
-    interrupt::guarded(|| bank.save(&args.out))
-        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    let radiation = super::listener::stored_radiation(&args.mesh)?;
+    interrupt::guarded(|| match &radiation {
+        Some(table) => bank.save_with_radiation(&args.out, table),
+        None => bank.save(&args.out),
+    })
+    .with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let report = BankJson::new(&bank, false);
     if args.json {
         print_json(&report)

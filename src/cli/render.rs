@@ -171,11 +171,7 @@ impl BankProvider for PipelineProvider<'_> {
             (None, None) => return Ok(None),
         };
         if let Some(path) = &request.bank {
-            let table = if modal_export::gltf::is_gltf_path(path) {
-                None
-            } else {
-                ModeBank::load_with_radiation(path)?.1
-            };
+            let table = super::listener::stored_radiation(path)?;
             if table.is_none() {
                 self.warnings.push(format!(
                     "{what} has no radiation table: its level is a pulsating-sphere estimate \

@@ -4,7 +4,7 @@
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
     /// The bank has no mode with a positive damped frequency to export.
-    #[error("the bank has no underdamped mode to export (a Faust modeFilter needs a positive frequency)")]
+    #[error("the bank has no underdamped mode to export (every mode is overdamped, ξ ≥ 1, or it has none)")]
     NoModes,
     /// No excitation position was given.
     #[error("no excitation position: give at least one --at X,Y,Z")]
@@ -32,9 +32,6 @@ pub enum ExportError {
     /// The bank has no surface triangles.
     #[error("the bank has no surface triangles to export")]
     NoSurface,
-    /// A mode has no oscillation (ξ ≥ 1), which glTF's positive frequencies cannot express.
-    #[error("mode {0} is overdamped (no positive damped frequency for glTF's frequencies)")]
-    Overdamped(usize),
     /// A count beyond what the format can index.
     #[error("too large for glTF: {0}")]
     TooLarge(String),

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use modal_bank::ModeBank;
+use modal_bank::{ModeBank, ModeTransfer, RadiationTable};
 use modal_export::gltf::{export_glb, import_glb, EXTENSION};
 use modal_export::ExportError;
 use modal_synth::synthetic::{SplitMix64, SyntheticBank};
@@ -54,13 +54,135 @@ fn quadratic_bank() -> ModeBank {
 #[test]
 fn export_then_import_gives_the_same_bank_bit_for_bit() {
     for bank in [linear_bank(), quadratic_bank()] {
-        let bytes = export_glb(&bank, "box", true).unwrap();
+        let bytes = export_glb(&bank, None, "box", true).unwrap().bytes;
         let imported = import_glb(&bytes).unwrap();
         assert!(imported.exact);
         assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
         assert_eq!(imported.name.as_deref(), Some("box"));
         assert_eq!(imported.bank, bank);
     }
+}
+
+/// An acoustic transfer for modes 1, 3 and 4 of `bank`, with awkward f64 values.
+fn radiation(bank: &ModeBank) -> RadiationTable {
+    let mut rng = SplitMix64::new(11);
+    let modes = [(1, 2), (3, 0), (4, 5)]
+        .map(|(mode, order)| ModeTransfer {
+            mode,
+            wavenumber: 2.0 * std::f64::consts::PI * bank.frequencies_hz[mode] / 343.0,
+            order,
+            coefficients: (0..(order + 1) * (order + 1))
+                .map(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)])
+                .collect(),
+            power_w: rng.range(0.0, 1e-3),
+            efficiency: rng.range(0.0, 1.0),
+        })
+        .to_vec();
+    RadiationTable {
+        centre_m: bank.mass.center_of_mass_m,
+        fit_radius_m: 0.1 + rng.range(0.0, 1e-3),
+        air_density_kg_m3: 1.21,
+        sound_speed_m_s: 343.0,
+        tolerance: 1e-3,
+        modes,
+    }
+}
+
+#[test]
+fn the_acoustic_transfer_travels_in_the_side_data_bit_for_bit() {
+    for bank in [linear_bank(), quadratic_bank()] {
+        let table = radiation(&bank);
+        let glb = export_glb(&bank, Some(&table), "box", true).unwrap();
+        assert_eq!((glb.radiation_modes, glb.overdamped_left_out), (3, 0));
+        let imported = import_glb(&glb.bytes).unwrap();
+        assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
+        assert_eq!(imported.bank, bank);
+        assert_eq!(imported.radiation.as_ref(), Some(&table));
+        // Without the side data there is no place for it.
+        let plain = export_glb(&bank, Some(&table), "box", false).unwrap();
+        assert_eq!(plain.radiation_modes, 0);
+        assert_eq!(import_glb(&plain.bytes).unwrap().radiation, None);
+    }
+    // A damaged table is dropped with a warning; the bank itself still reads exactly.
+    let bank = linear_bank();
+    let (mut json, bin) = split_glb(&export_glb(&bank, Some(&radiation(&bank)), "box", true).unwrap().bytes);
+    json["extensions"][EXTENSION]["modalModels"][0]["extras"]["modal"]["radiation"]["modes"][2] = 99.into();
+    let imported = import_glb(&join_glb(&json, &bin)).unwrap();
+    assert!(imported.exact && imported.radiation.is_none());
+    assert!(imported.warnings.iter().any(|w| w.contains("radiation is ignored")), "{:?}", imported.warnings);
+}
+
+#[test]
+fn overdamped_modes_are_left_out_with_their_transfer() {
+    let mut bank = linear_bank();
+    // Mode 3 overdamped (ξ = 1.5: no damped frequency).
+    bank.damping_ratios[3] = 1.5;
+    bank.decay_rates[3] = 1.5 * 2.0 * std::f64::consts::PI * bank.frequencies_hz[3];
+    bank.info.error_estimate_pct = (0..bank.mode_count()).map(|i| Some(0.1 * i as f64)).collect();
+    let table = radiation(&bank);
+    let glb = export_glb(&bank, Some(&table), "box", true).unwrap();
+    assert_eq!(glb.overdamped_left_out, 1);
+    let imported = import_glb(&glb.bytes).unwrap();
+    let got = &imported.bank;
+    assert_eq!(got.mode_count(), bank.mode_count() - 1);
+    let kept: Vec<usize> = (0..bank.mode_count()).filter(|&i| i != 3).collect();
+    let s = 3 * bank.surface_node_count();
+    for (new, &old) in kept.iter().enumerate() {
+        assert_eq!(got.frequencies_hz[new], bank.frequencies_hz[old]);
+        assert_eq!(got.info.error_estimate_pct[new], bank.info.error_estimate_pct[old]);
+        assert_eq!(got.shapes[new * s..(new + 1) * s], bank.shapes[old * s..(old + 1) * s]);
+    }
+    // Transfer of modes 1, 3, 4: mode 3 is gone, mode 4 is now mode 3.
+    let got = imported.radiation.unwrap();
+    assert_eq!(got.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), vec![1, 3]);
+    assert_eq!(got.modes[1].coefficients, table.modes[2].coefficients);
+    // Nothing underdamped: nothing to export.
+    bank.damping_ratios.iter_mut().for_each(|z| *z = 2.0);
+    for i in 0..bank.mode_count() {
+        bank.decay_rates[i] = 2.0 * 2.0 * std::f64::consts::PI * bank.frequencies_hz[i];
+    }
+    assert!(matches!(export_glb(&bank, None, "box", true), Err(ExportError::NoModes)));
+}
+
+#[test]
+fn a_material_or_mass_edited_by_another_tool_wins_over_the_side_data() {
+    let bank = linear_bank();
+    let (json, bin) = split_glb(&export_glb(&bank, None, "box", true).unwrap().bytes);
+    let mut softer = json.clone();
+    softer["extensions"][EXTENSION]["acousticMaterials"][0]["density"] = 1000.0.into();
+    let imported = import_glb(&join_glb(&softer, &bin)).unwrap();
+    assert!(!imported.exact);
+    assert_eq!(imported.bank.material.density_kg_m3, 1000.0);
+    assert!(imported.warnings.iter().any(|w| w.contains("density is 1000")), "{:?}", imported.warnings);
+    let mut heavier = json.clone();
+    heavier["extensions"][EXTENSION]["modalModels"][0]["massProperties"]["mass"] = 10.0.into();
+    let imported = import_glb(&join_glb(&heavier, &bin)).unwrap();
+    assert!(!imported.exact);
+    assert_eq!(imported.bank.mass.mass_kg, 10.0);
+    for mass in [0.0, -1.0] {
+        let mut bad = json.clone();
+        bad["extensions"][EXTENSION]["modalModels"][0]["massProperties"]["mass"] = mass.into();
+        let message = import_glb(&join_glb(&bad, &bin)).unwrap_err().to_string();
+        assert!(message.contains("massProperties.mass") && message.contains("must be positive"), "{message}");
+    }
+}
+
+#[test]
+fn a_file_with_acoustic_data_but_no_modal_model_is_geometry() {
+    let bank = linear_bank();
+    let dir = tempfile::tempdir().unwrap();
+    let (json, bin) = split_glb(&export_glb(&bank, None, "box", true).unwrap().bytes);
+    let path = dir.path().join("model.glb");
+    std::fs::write(&path, join_glb(&json, &bin)).unwrap();
+    assert!(modal_export::gltf::holds_modal_model(&path).unwrap());
+    // The draft lets a file hold acoustic materials and surfaces alone.
+    let mut surfaces = json.clone();
+    let root = &mut surfaces["extensions"][EXTENSION];
+    root.as_object_mut().unwrap().remove("modalModels");
+    root["acousticSurfaces"] = serde_json::json!([{ "roughness": 2e-6, "material": 0 }]);
+    surfaces["nodes"][0]["extensions"][EXTENSION] = serde_json::json!({ "acousticSurface": 0 });
+    std::fs::write(&path, join_glb(&surfaces, &bin)).unwrap();
+    assert!(!modal_export::gltf::holds_modal_model(&path).unwrap());
 }
 
 /// The JSON chunk and the binary chunk of GLB bytes.
@@ -84,7 +206,7 @@ fn join_glb(json: &Value, bin: &[u8]) -> Vec<u8> {
 #[test]
 fn the_gltf_crate_reads_the_mesh_and_the_documented_accessors() {
     let bank = quadratic_bank();
-    let bytes = export_glb(&bank, "box", true).unwrap();
+    let bytes = export_glb(&bank, None, "box", true).unwrap().bytes;
     let gltf = gltf::Gltf::from_slice(&bytes).expect("a valid glTF document");
     let blob = gltf.blob.clone().unwrap();
     let buffers = |_: gltf::Buffer| Some(blob.as_slice());
@@ -137,7 +259,7 @@ fn the_gltf_crate_reads_the_mesh_and_the_documented_accessors() {
 #[test]
 fn without_the_side_data_the_khr_data_alone_makes_the_bank() {
     let bank = linear_bank();
-    let imported = import_glb(&export_glb(&bank, "box", false).unwrap()).unwrap();
+    let imported = import_glb(&export_glb(&bank, None, "box", false).unwrap().bytes).unwrap();
     assert!(!imported.exact);
     let got = &imported.bank;
     assert_eq!(got.mode_count(), bank.mode_count());
@@ -169,7 +291,7 @@ fn without_the_side_data_the_khr_data_alone_makes_the_bank() {
 #[test]
 fn edited_side_data_is_ignored_with_a_warning() {
     let bank = linear_bank();
-    let (mut json, bin) = split_glb(&export_glb(&bank, "box", true).unwrap());
+    let (mut json, bin) = split_glb(&export_glb(&bank, None, "box", true).unwrap().bytes);
     json["extensions"][EXTENSION]["modalModels"][0]["extras"]["modal"]["frequenciesHz"][2] = 1234.5.into();
     let imported = import_glb(&join_glb(&json, &bin)).unwrap();
     assert!(!imported.exact);
@@ -184,7 +306,7 @@ fn edited_side_data_is_ignored_with_a_warning() {
 #[test]
 fn the_older_khr_audio_modal_spelling_is_read() {
     let bank = linear_bank();
-    let (mut json, bin) = split_glb(&export_glb(&bank, "box", false).unwrap());
+    let (mut json, bin) = split_glb(&export_glb(&bank, None, "box", false).unwrap().bytes);
     let root = json["extensions"].as_object_mut().unwrap().remove(EXTENSION).unwrap();
     json["extensions"]["KHR_audio_modal"] =
         serde_json::json!({ "models": root["modalModels"], "materials": root["acousticMaterials"] });
@@ -198,7 +320,7 @@ fn the_older_khr_audio_modal_spelling_is_read() {
 #[test]
 fn modes_out_of_order_are_sorted() {
     let bank = linear_bank();
-    let (mut json, bin) = split_glb(&export_glb(&bank, "box", false).unwrap());
+    let (mut json, bin) = split_glb(&export_glb(&bank, None, "box", false).unwrap().bytes);
     // Point the frequencies and decay rates at reversed copies (appended views).
     let n = bank.mode_count();
     let mut bin = bin;
@@ -239,7 +361,7 @@ fn modes_out_of_order_are_sorted() {
 #[test]
 fn malformed_files_and_models_give_one_clear_error() {
     let bank = linear_bank();
-    let (json, bin) = split_glb(&export_glb(&bank, "box", false).unwrap());
+    let (json, bin) = split_glb(&export_glb(&bank, None, "box", false).unwrap().bytes);
     let err = |json: &Value| import_glb(&join_glb(json, &bin)).unwrap_err().to_string();
 
     assert!(matches!(import_glb(b"not a gltf at all"), Err(ExportError::Gltf(_))));

@@ -23,7 +23,7 @@ mod read;
 mod write;
 
 pub use read::{holds_modal_model, import_glb, import_gltf_file, is_gltf_path, Imported};
-pub use write::{export_glb, glb_container};
+pub use write::{export_glb, glb_container, GlbExport};
 
 /// Name of the extension written (and read).
 pub const EXTENSION: &str = "KHR_audio_rigid_bodies";

@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use modal_bank::{ModeBank, SolveInfo};
+use modal_bank::{ModeBank, ModeTransfer, RadiationTable, SolveInfo};
 use modal_fem::{MassProperties, Material};
 use modal_mesh::Surface;
 use serde::Deserialize;
@@ -26,6 +26,8 @@ use crate::ExportError;
 pub struct Imported {
     /// The bank.
     pub bank: ModeBank,
+    /// Its acoustic transfer, when the exact side data carries one.
+    pub radiation: Option<RadiationTable>,
     /// True when the exact side data (`extras.modal`) was used.
     pub exact: bool,
     /// Index of the model read in the document's model array.
@@ -43,14 +45,21 @@ pub fn is_gltf_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
 }
 
-/// Whether the glTF file at `path` carries a modal model (the
-/// `KHR_audio_rigid_bodies` root extension, or its legacy name): then it is
-/// a bank; without one it is only geometry, to be meshed and solved.
+/// Whether the glTF file at `path` carries a modal model (a non-empty
+/// model array in the `KHR_audio_rigid_bodies` root extension, or its
+/// legacy name): then it is a bank; without one it is only geometry, to be
+/// meshed and solved (the draft lets a file hold acoustic materials and
+/// surfaces alone).
 pub fn holds_modal_model(path: &Path) -> Result<bool, ExportError> {
     let bytes =
         std::fs::read(path).map_err(|source| ExportError::Read { path: path.to_path_buf(), source })?;
     let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| ExportError::Gltf(e.to_string()))?;
-    Ok(gltf.extension_value(EXTENSION).is_some() || gltf.extension_value(LEGACY_EXTENSION).is_some())
+    let has_models = |root: Option<&Value>| {
+        root.and_then(|r| r.get("modalModels").or_else(|| r.get("models")))
+            .and_then(Value::as_array)
+            .is_some_and(|models| !models.is_empty())
+    };
+    Ok(has_models(gltf.extension_value(EXTENSION)) || has_models(gltf.extension_value(LEGACY_EXTENSION)))
 }
 
 /// Reads the modal model of a `.glb`, or of a `.gltf` whose buffers are
@@ -131,6 +140,26 @@ struct ExactJson {
     material: Material,
     mass_properties: MassProperties,
     solve_info: SolveInfo,
+    #[serde(default)]
+    radiation: Option<Value>,
+}
+
+/// `extras.modal.radiation`, written by `radiation_side_data` (write.rs).
+#[derive(Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct RadiationJson {
+    centre_m: [f64; 3],
+    fit_radius_m: f64,
+    air_density_kg_m3: f64,
+    #[serde(rename = "soundSpeedMS")]
+    sound_speed_m_s: f64,
+    tolerance: f64,
+    modes: Vec<usize>,
+    wavenumbers: Vec<f64>,
+    orders: Vec<usize>,
+    power_w: Vec<f64>,
+    efficiency: Vec<f64>,
+    coefficients_f64: usize,
 }
 
 fn bad(message: impl Into<String>) -> ExportError {
@@ -275,25 +304,36 @@ fn material(root: &RootJson, model: &ModelJson) -> Result<Material, ExportError>
     Ok(material)
 }
 
-fn mass_properties(model: &ModelJson, density: f64, warnings: &mut Vec<String>) -> MassProperties {
-    match &model.mass_properties {
-        Some(m) => MassProperties {
-            volume_m3: m.mass / density,
-            mass_kg: m.mass,
-            center_of_mass_m: m.center_of_mass,
-            inertia_kg_m2: inertia::tensor(m.inertia_diagonal, m.inertia_orientation),
-        },
-        None => {
-            warnings
-                .push("the model has no massProperties: mass, centre of mass and inertia read as 0".into());
-            MassProperties {
-                volume_m3: 0.0,
-                mass_kg: 0.0,
-                center_of_mass_m: [0.0; 3],
-                inertia_kg_m2: [[0.0; 3]; 3],
-            }
-        }
+fn mass_properties(
+    model: &ModelJson,
+    density: f64,
+    warnings: &mut Vec<String>,
+) -> Result<MassProperties, ExportError> {
+    let Some(m) = &model.mass_properties else {
+        warnings.push("the model has no massProperties: mass, centre of mass and inertia read as 0".into());
+        return Ok(MassProperties {
+            volume_m3: 0.0,
+            mass_kg: 0.0,
+            center_of_mass_m: [0.0; 3],
+            inertia_kg_m2: [[0.0; 3]; 3],
+        });
+    };
+    // The draft's schema: mass > 0, principal moments ≥ 0.
+    if !(m.mass.is_finite() && m.mass > 0.0) {
+        return Err(bad(format!("massProperties.mass = {} kg must be positive", m.mass)));
     }
+    if let Some(i) = m.inertia_diagonal.iter().position(|&j| !(j.is_finite() && j >= 0.0)) {
+        return Err(bad(format!(
+            "massProperties.inertiaDiagonal[{i}] = {} kg·m² must be ≥ 0",
+            m.inertia_diagonal[i]
+        )));
+    }
+    Ok(MassProperties {
+        volume_m3: m.mass / density,
+        mass_kg: m.mass,
+        center_of_mass_m: m.center_of_mass,
+        inertia_kg_m2: inertia::tensor(m.inertia_diagonal, m.inertia_orientation),
+    })
 }
 
 fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
@@ -336,15 +376,23 @@ fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
         return Err(bad(format!("indices[{i}] = {} is not below the {s} positions", indices[i])));
     }
     let material = material(&root, model)?;
+    let mass = mass_properties(model, material.density_kg_m3, &mut warnings)?;
     if let Some(exact) = model.extras.as_ref().and_then(|e| e.get(EXTRAS_KEY)) {
-        match exact_bank(&doc, exact, &freqs, &decays, &positions, &shapes) {
-            Ok(bank) => {
-                return Ok(Imported { bank, exact: true, model: index, name: model.name.clone(), warnings })
+        let khr = Khr { freqs: &freqs, decays: &decays, positions: &positions, shapes: &shapes };
+        match exact_bank(&doc, exact, &khr).and_then(|(bank, radiation)| {
+            agrees_with_khr(&bank, &material, model).map(|()| (bank, radiation))
+        }) {
+            Ok((bank, radiation)) => {
+                let radiation = radiation.unwrap_or_else(|why| {
+                    warnings.push(format!("extras.{EXTRAS_KEY}.radiation is ignored: {why}"));
+                    None
+                });
+                let name = model.name.clone();
+                return Ok(Imported { bank, radiation, exact: true, model: index, name, warnings });
             }
             Err(why) => warnings.push(format!("extras.{EXTRAS_KEY} is ignored: {why}")),
         }
     }
-    let mass = mass_properties(model, material.density_kg_m3, &mut warnings);
     // Undamped ω and ξ from the damped frequency and the decay rate, in ascending order.
     let mut modes: Vec<(f64, f64, usize)> = (0..n)
         .map(|i| {
@@ -378,7 +426,7 @@ fn import(bytes: &[u8], base: Option<&Path>) -> Result<Imported, ExportError> {
         info: SolveInfo::default(),
     };
     bank.validate().map_err(ExportError::InvalidBank)?;
-    Ok(Imported { bank, exact: false, model: index, name: model.name.clone(), warnings })
+    Ok(Imported { bank, radiation: None, exact: false, model: index, name: model.name.clone(), warnings })
 }
 
 fn le_words<const N: usize>(bytes: &[u8], count: usize, what: &str) -> Result<Vec<[u8; N]>, String> {
@@ -397,15 +445,22 @@ fn triples(bytes: &[u8], rows: usize, bound: usize, what: &str) -> Result<Vec<[u
     Ok(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
 }
 
-/// The exact bank of `extras.modal`, if it agrees with the KHR data.
-fn exact_bank(
-    doc: &Doc,
-    extras: &Value,
-    freqs: &[f32],
-    decays: &[f32],
-    positions: &[[f32; 3]],
-    shapes: &[[f32; 3]],
-) -> Result<ModeBank, String> {
+/// The model's KHR accessors, against which the exact side data is checked.
+struct Khr<'a> {
+    freqs: &'a [f32],
+    decays: &'a [f32],
+    positions: &'a [[f32; 3]],
+    shapes: &'a [[f32; 3]],
+}
+
+/// The acoustic transfer of the side data: `Ok(None)` when none is stored,
+/// `Err` when it cannot be used (the bank still can).
+type SideRadiation = Result<Option<RadiationTable>, String>;
+
+/// The exact bank of `extras.modal`, if it agrees with the KHR accessors,
+/// and its acoustic transfer.
+fn exact_bank(doc: &Doc, extras: &Value, khr: &Khr) -> Result<(ModeBank, SideRadiation), String> {
+    let Khr { freqs, decays, positions, shapes } = *khr;
     let exact: ExactJson = serde_json::from_value(extras.clone()).map_err(|e| e.to_string())?;
     if exact.format != "modal-bank" {
         return Err(format!("format '{}' is not modal-bank", exact.format));
@@ -453,5 +508,83 @@ fn exact_bank(
     }
     bank.validate().map_err(|e| e.to_string())?;
     bank.shapes.shrink_to_fit();
-    Ok(bank)
+    let radiation = match &exact.radiation {
+        None => Ok(None),
+        Some(value) => radiation_table(doc, value, n).map(Some),
+    };
+    Ok((bank, radiation))
+}
+
+/// Whether the exact bank's material and mass are the KHR ones: another
+/// tool editing the file changes those and leaves our side data alone, so
+/// a difference means the KHR data are the user's (compared exactly: both
+/// were written from the same f64 values; the inertia to rounding, since
+/// the KHR data hold it as principal moments and axes).
+fn agrees_with_khr(bank: &ModeBank, material: &Material, model: &ModelJson) -> Result<(), String> {
+    let ours = &bank.material;
+    for (what, exact, khr) in [
+        ("density", ours.density_kg_m3, material.density_kg_m3),
+        ("youngsModulus", ours.youngs_pa, material.youngs_pa),
+        ("poissonRatio", ours.poisson, material.poisson),
+        ("alpha", ours.alpha, material.alpha),
+        ("beta", ours.beta, material.beta),
+    ] {
+        if exact != khr {
+            return Err(format!("the acoustic material's {what} is {khr}, the side data's {exact}"));
+        }
+    }
+    let Some(m) = &model.mass_properties else { return Ok(()) };
+    if m.mass != bank.mass.mass_kg || m.center_of_mass != bank.mass.center_of_mass_m {
+        return Err(format!(
+            "massProperties (mass {} kg, centre {:?}) differ from the side data's ({} kg, {:?})",
+            m.mass, m.center_of_mass, bank.mass.mass_kg, bank.mass.center_of_mass_m
+        ));
+    }
+    let khr_inertia = inertia::tensor(m.inertia_diagonal, m.inertia_orientation);
+    let scale = bank.mass.inertia_kg_m2.iter().flatten().fold(0.0f64, |a, &x| a.max(x.abs()));
+    let off = (0..9).map(|k| (khr_inertia[k / 3][k % 3] - bank.mass.inertia_kg_m2[k / 3][k % 3]).abs());
+    if off.fold(0.0f64, f64::max) > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+        return Err("massProperties' inertia differs from the side data's".into());
+    }
+    Ok(())
+}
+
+/// The acoustic transfer of `extras.modal.radiation` for a bank of
+/// `mode_count` modes.
+fn radiation_table(doc: &Doc, value: &Value, mode_count: usize) -> Result<RadiationTable, String> {
+    let r: RadiationJson = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+    let count = r.modes.len();
+    if [r.wavenumbers.len(), r.orders.len(), r.power_w.len(), r.efficiency.len()].iter().any(|&l| l != count)
+    {
+        return Err(format!("its per-mode arrays differ in length from its {count} modes"));
+    }
+    // Each order's (L+1)² coefficients, bounded before any allocation.
+    let sizes: Option<Vec<usize>> = r.orders.iter().map(|&l| l.checked_add(1)?.checked_mul(l + 1)).collect();
+    let sizes = sizes.ok_or("an order is absurdly large")?;
+    let total = sizes.iter().try_fold(0usize, |a, &n| a.checked_add(n)).ok_or("too many coefficients")?;
+    let bytes = doc.view(r.coefficients_f64).map_err(|e| e.to_string())?;
+    let words =
+        le_words::<8>(bytes, total.checked_mul(2).ok_or("too many coefficients")?, "coefficientsF64")?;
+    let values: Vec<f64> = words.into_iter().map(f64::from_le_bytes).collect();
+    let mut pairs = values.chunks_exact(2).map(|c| [c[0], c[1]]);
+    let modes = (0..count)
+        .map(|i| ModeTransfer {
+            mode: r.modes[i],
+            wavenumber: r.wavenumbers[i],
+            order: r.orders[i],
+            coefficients: pairs.by_ref().take(sizes[i]).collect(),
+            power_w: r.power_w[i],
+            efficiency: r.efficiency[i],
+        })
+        .collect();
+    let table = RadiationTable {
+        centre_m: r.centre_m,
+        fit_radius_m: r.fit_radius_m,
+        air_density_kg_m3: r.air_density_kg_m3,
+        sound_speed_m_s: r.sound_speed_m_s,
+        tolerance: r.tolerance,
+        modes,
+    };
+    table.validate(mode_count).map_err(|e| e.to_string())?;
+    Ok(table)
 }

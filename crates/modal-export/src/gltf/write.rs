@@ -5,7 +5,9 @@
 //! zeros, each to a multiple of 4 bytes. Every buffer view starts at a
 //! multiple of 8 bytes, so f64 side data is aligned too.
 
-use modal_bank::ModeBank;
+use std::borrow::Cow;
+
+use modal_bank::{ModeBank, RadiationTable};
 use serde_json::{json, Value};
 
 use super::{EXTENSION, EXTRAS_KEY, FLOAT, UNSIGNED_INT};
@@ -93,16 +95,113 @@ fn flat_triangles(bank: &ModeBank) -> Vec<[usize; 3]> {
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
-/// The bank as a GLB file named `name` (mesh, node and model names).
-/// `extras`: also write the exact side data (see [`crate::gltf`]).
-pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, ExportError> {
+/// A bank written as GLB bytes, and what could not be written.
+#[derive(Clone, Debug)]
+pub struct GlbExport {
+    /// The file's bytes.
+    pub bytes: Vec<u8>,
+    /// Overdamped modes left out (ξ ≥ 1: glTF's frequencies are damped
+    /// frequencies, which such a mode does not have).
+    pub overdamped_left_out: usize,
+    /// Modes whose acoustic transfer was written (in `extras.modal`).
+    pub radiation_modes: usize,
+}
+
+/// The bank as a GLB file named `name` (mesh, node and model names), its
+/// overdamped modes left out. `extras`: also write the exact side data (see
+/// [`crate::gltf`]), with `radiation`, the bank's stored acoustic transfer,
+/// if any (no KHR draft has a place for it).
+pub fn export_glb(
+    bank: &ModeBank,
+    radiation: Option<&RadiationTable>,
+    name: &str,
+    extras: bool,
+) -> Result<GlbExport, ExportError> {
     bank.validate().map_err(ExportError::InvalidBank)?;
+    if let Some(table) = radiation {
+        table.validate(bank.mode_count()).map_err(ExportError::InvalidBank)?;
+    }
+    let Underdamped { bank, radiation, left_out: overdamped_left_out } = underdamped_only(bank, radiation)?;
+    let radiation = radiation.filter(|_| extras);
+    let radiation_modes = radiation.as_ref().map_or(0, |t| t.modes.len());
+    let bytes = write_glb(&bank, radiation.as_deref(), name, extras)?;
+    Ok(GlbExport { bytes, overdamped_left_out, radiation_modes })
+}
+
+/// A bank and its transfer without their overdamped modes.
+struct Underdamped<'a> {
+    bank: Cow<'a, ModeBank>,
+    radiation: Option<Cow<'a, RadiationTable>>,
+    /// How many modes were left out.
+    left_out: usize,
+}
+
+/// The bank and its transfer without the overdamped modes (whose damped
+/// frequency rounds to 0 in f32).
+fn underdamped_only<'a>(
+    bank: &'a ModeBank,
+    radiation: Option<&'a RadiationTable>,
+) -> Result<Underdamped<'a>, ExportError> {
+    let keep: Vec<usize> =
+        (0..bank.mode_count()).filter(|&i| bank.damped_frequency_hz(i) as f32 > 0.0).collect();
+    if keep.is_empty() {
+        return Err(ExportError::NoModes);
+    }
+    let left_out = bank.mode_count() - keep.len();
+    if left_out == 0 {
+        return Ok(Underdamped {
+            bank: Cow::Borrowed(bank),
+            radiation: radiation.map(Cow::Borrowed),
+            left_out,
+        });
+    }
+    let s3 = 3 * bank.surface_node_count();
+    let pick = |values: &[f64]| keep.iter().map(|&i| values[i]).collect::<Vec<f64>>();
+    let mut info = bank.info.clone();
+    if info.error_estimate_pct.len() == bank.mode_count() {
+        info.error_estimate_pct = keep.iter().map(|&i| bank.info.error_estimate_pct[i]).collect();
+    }
+    let kept = ModeBank {
+        frequencies_hz: pick(&bank.frequencies_hz),
+        damping_ratios: pick(&bank.damping_ratios),
+        decay_rates: pick(&bank.decay_rates),
+        residuals: pick(&bank.residuals),
+        shapes: keep.iter().flat_map(|&i| bank.shapes[i * s3..(i + 1) * s3].iter().copied()).collect(),
+        surface: bank.surface.clone(),
+        material: bank.material.clone(),
+        mass: bank.mass,
+        info,
+    };
+    let radiation = radiation.map(|table| {
+        let modes = table
+            .modes
+            .iter()
+            .filter_map(|m| {
+                let new_index = keep.binary_search(&m.mode).ok()?;
+                Some(modal_bank::ModeTransfer { mode: new_index, ..m.clone() })
+            })
+            .collect();
+        Cow::Owned(RadiationTable {
+            centre_m: table.centre_m,
+            fit_radius_m: table.fit_radius_m,
+            air_density_kg_m3: table.air_density_kg_m3,
+            sound_speed_m_s: table.sound_speed_m_s,
+            tolerance: table.tolerance,
+            modes,
+        })
+    });
+    Ok(Underdamped { bank: Cow::Owned(kept), radiation, left_out })
+}
+
+fn write_glb(
+    bank: &ModeBank,
+    radiation: Option<&RadiationTable>,
+    name: &str,
+    extras: bool,
+) -> Result<Vec<u8>, ExportError> {
     let n = bank.mode_count();
     let s = bank.surface_node_count();
     let triangles = flat_triangles(bank);
-    if n == 0 {
-        return Err(ExportError::NoModes);
-    }
     if s == 0 || triangles.is_empty() {
         return Err(ExportError::NoSurface);
     }
@@ -116,9 +215,7 @@ pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, 
     let indices: Vec<u32> = triangles.iter().flatten().map(|&i| i as u32).collect();
     let index_view = layout.view(&le_bytes(&indices, u32::to_le_bytes), Some(ELEMENT_ARRAY_BUFFER));
     let indices = layout.accessor(index_view, UNSIGNED_INT, triangles.len() * 3, "SCALAR", None);
-    if let Some(i) = (0..n).find(|&i| bank.damped_frequency_hz(i) as f32 <= 0.0) {
-        return Err(ExportError::Overdamped(i));
-    }
+    debug_assert!((0..n).all(|i| bank.damped_frequency_hz(i) as f32 > 0.0));
     let frequencies = layout.floats((0..n).map(|i| bank.damped_frequency_hz(i) as f32), "SCALAR", None);
     let decay_rates = layout.floats(bank.decay_rates.iter().map(|&d| d as f32), "SCALAR", None);
     let shapes = layout.floats(bank.shapes.iter().copied(), "VEC3", None);
@@ -150,7 +247,7 @@ pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, 
         });
     }
     if extras {
-        model["extras"] = json!({ EXTRAS_KEY: exact_side_data(bank, &mut layout) });
+        model["extras"] = json!({ EXTRAS_KEY: exact_side_data(bank, radiation, &mut layout) });
     }
     let document = json!({
         "asset": { "version": "2.0", "generator": format!("modal {}", env!("CARGO_PKG_VERSION")) },
@@ -175,7 +272,7 @@ pub fn export_glb(bank: &ModeBank, name: &str, extras: bool) -> Result<Vec<u8>, 
 }
 
 /// The `extras.modal` object: exact copies of what the accessors round.
-fn exact_side_data(bank: &ModeBank, layout: &mut Layout) -> Value {
+fn exact_side_data(bank: &ModeBank, radiation: Option<&RadiationTable>, layout: &mut Layout) -> Value {
     let surface = &bank.surface;
     let positions: Vec<f64> = surface.positions.iter().flatten().copied().collect();
     let positions = layout.view(&le_bytes(&positions, f64::to_le_bytes), None);
@@ -187,7 +284,7 @@ fn exact_side_data(bank: &ModeBank, layout: &mut Layout) -> Value {
     let edge_nodes = surface.triangle_edge_nodes.as_ref().map(|e| index_view(layout, e));
     let node_ids: Vec<u64> = surface.node_ids.iter().map(|&i| i as u64).collect();
     let node_ids = layout.view(&le_bytes(&node_ids, u64::to_le_bytes), None);
-    json!({
+    let mut side = json!({
         "format": "modal-bank",
         "formatVersion": modal_bank::FORMAT_VERSION,
         "frequenciesHz": bank.frequencies_hz,
@@ -201,6 +298,35 @@ fn exact_side_data(bank: &ModeBank, layout: &mut Layout) -> Value {
         "material": bank.material,
         "massProperties": bank.mass,
         "solveInfo": bank.info,
+    });
+    if let Some(table) = radiation {
+        side["radiation"] = radiation_side_data(table, layout);
+    }
+    side
+}
+
+/// The acoustic transfer as `extras.modal.radiation`: per-mode values as
+/// JSON numbers (exact, like the frequencies) and the multipole
+/// coefficients as one buffer view of little-endian f64 (re, im) pairs,
+/// mode after mode (crate `modal_bank`'s `RadiationTable`).
+fn radiation_side_data(table: &RadiationTable, layout: &mut Layout) -> Value {
+    let coefficients: Vec<f64> =
+        table.modes.iter().flat_map(|m| m.coefficients.iter().flatten()).copied().collect();
+    let coefficients = layout.view(&le_bytes(&coefficients, f64::to_le_bytes), None);
+    let column =
+        |f: fn(&modal_bank::ModeTransfer) -> Value| table.modes.iter().map(f).collect::<Vec<Value>>();
+    json!({
+        "centreM": table.centre_m,
+        "fitRadiusM": table.fit_radius_m,
+        "airDensityKgM3": table.air_density_kg_m3,
+        "soundSpeedMS": table.sound_speed_m_s,
+        "tolerance": table.tolerance,
+        "modes": column(|m| json!(m.mode)),
+        "wavenumbers": column(|m| json!(m.wavenumber)),
+        "orders": column(|m| json!(m.order)),
+        "powerW": column(|m| json!(m.power_w)),
+        "efficiency": column(|m| json!(m.efficiency)),
+        "coefficientsF64": coefficients,
     })
 }
 
