@@ -79,7 +79,7 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     // A glTF with a modal model is a bank; one without is geometry, meshed like an OBJ.
     if modal_export::gltf::is_gltf_path(&args.mesh)
         && modal_export::gltf::holds_modal_model(&args.mesh)
-            .with_context(|| format!("cannot read {}", args.mesh.display()))?
+            .with_context(|| format!("precompute {}", args.mesh.display()))?
     {
         return import_gltf(&args);
     }
