@@ -397,6 +397,10 @@ fn a_file_in_millimetres_is_refused_at_once_and_solved_with_its_scale() {
         modal(dir.path(), &["mesh", "tet", "block_mm.obj", "-o", "block_mm.msh", "--cell", "8"]).ok();
     assert!(meshed.stderr.contains("--scale 0.001"), "{}", meshed.stderr);
     precompute("block_mm.msh", &[]).fails_with("--scale 0.001");
+    // A stated scale must still be a unit conversion (1e300 overflowed every coordinate).
+    for absurd in ["1e300", "1e-300"] {
+        precompute("block_mm.obj", &["--scale", absurd]).fails_with("no unit conversion");
+    }
     // With its scale it is the 40 mm block, and its modes are those of the file in metres.
     let in_metres = std::fs::File::create(dir.path().join("block.obj")).unwrap();
     modal_tetra::write_obj(&modal_tetra::shapes::cuboid(0.04, 0.02, 0.016), in_metres).unwrap();

@@ -375,8 +375,8 @@ impl Manifest {
 
 /// The checks `modal precompute` makes on its flags, phrased with manifest keys.
 fn check_request(r: &Request, o: &Options) -> Result<(), String> {
-    if !(r.scale.is_finite() && r.scale > 0.0) {
-        return Err(format!("`scale` must be a positive number, got {}", r.scale));
+    if let Some(why) = modal_mesh::scale_refusal(r.scale) {
+        return Err(format!("`scale` {why}"));
     }
     if !matches!(r.order, 1 | 2) {
         return Err(format!("`order` must be 1 or 2, got {}", r.order));

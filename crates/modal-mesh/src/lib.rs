@@ -55,8 +55,8 @@ pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;
 pub use types::*;
 pub use units::{
-    bounding_box, bounding_diagonal, unit_warning, unstated_size_refusal, LARGEST_PLAIN_DIAGONAL_M,
-    LARGEST_UNREMARKED_DIAGONAL_M, SMALLEST_PLAIN_DIAGONAL_M,
+    bounding_box, bounding_diagonal, scale_refusal, unit_warning, unstated_size_refusal,
+    LARGEST_PLAIN_DIAGONAL_M, LARGEST_UNREMARKED_DIAGONAL_M, SCALE_RANGE, SMALLEST_PLAIN_DIAGONAL_M,
 };
 pub use validate::{
     check, connected_parts, tet10_shape_gradients, MeshReport, DEGENERATE_VOLUME_RATIO, SLIVER_ANGLE_DEG,

@@ -23,6 +23,29 @@ pub const LARGEST_UNREMARKED_DIAGONAL_M: f64 = 2.5;
 /// rings above any audio band.
 pub const SMALLEST_PLAIN_DIAGONAL_M: f64 = 0.005;
 
+/// The range of scale factors accepted, stated or not: a scale converts a
+/// file's unit to metres, from micrometres (10⁻⁶) to kilometres (10³) and
+/// a margin beyond. Outside it no conversion is meant (`--scale 1e300`
+/// overflowed every coordinate and ended in "every triangle has zero area").
+pub const SCALE_RANGE: std::ops::RangeInclusive<f64> = 1e-6..=1e6;
+
+/// Why `factor` cannot be a mesh file's scale, if it cannot: not a positive
+/// number, or outside [`SCALE_RANGE`]. Phrased to follow the key's name
+/// (`--scale`, `scale`).
+pub fn scale_refusal(factor: f64) -> Option<String> {
+    if !(factor.is_finite() && factor > 0.0) {
+        return Some(format!("must be a positive number, got {factor}"));
+    }
+    (!SCALE_RANGE.contains(&factor)).then(|| {
+        format!(
+            "= {factor:e} is no unit conversion: a scale turns a file's unit into metres (0.001 for \
+             millimetres, 0.0254 for inches) and lies between {:e} and {:e}",
+            SCALE_RANGE.start(),
+            SCALE_RANGE.end()
+        )
+    })
+}
+
 /// The bounding box (lower corner, upper corner) of `points`; (+∞, −∞) when
 /// there are none.
 pub fn bounding_box(points: impl IntoIterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
@@ -80,6 +103,23 @@ pub fn unstated_size_refusal(diagonal_m: f64) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_unit_conversions_are_scales() {
+        for factor in [1e-6, 0.001, 0.0254, 1.0, 1000.0, 1e6] {
+            assert_eq!(scale_refusal(factor), None, "{factor}");
+        }
+        for factor in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(
+                scale_refusal(factor).is_some_and(|w| w.starts_with("must be a positive number")),
+                "{factor}"
+            );
+        }
+        for factor in [1e300, 1e-300, 2e6, 5e-7] {
+            let why = scale_refusal(factor).expect("refused");
+            assert!(why.contains("no unit conversion") && why.contains(&format!("{factor:e}")), "{why}");
+        }
+    }
 
     #[test]
     fn a_millimetre_mug_is_refused_and_a_metre_one_is_not() {

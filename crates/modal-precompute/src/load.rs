@@ -195,8 +195,8 @@ pub(crate) fn load_mesh_sized(
     budget: Option<TetBudget>,
 ) -> Result<LoadedMesh, PrecomputeError> {
     let factor = scale.factor;
-    if !(factor.is_finite() && factor > 0.0) {
-        return Err(PrecomputeError::Invalid(format!("--scale must be a positive number, got {factor}")));
+    if let Some(why) = modal_mesh::scale_refusal(factor) {
+        return Err(PrecomputeError::Invalid(format!("--scale {why}")));
     }
     let mut warnings = Vec::new();
     let (mut cell_m, mut layered) = (None, false);

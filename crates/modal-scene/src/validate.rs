@@ -134,8 +134,8 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
     if o.order.is_some_and(|n| n != 1 && n != 2) {
         return Err(SceneError::invalid(key("order"), "must be 1 or 2"));
     }
-    if let Some(scale) = o.scale {
-        positive(&key("scale"), scale)?;
+    if let Some(why) = o.scale.and_then(modal_mesh::scale_refusal) {
+        return Err(SceneError::invalid(key("scale"), why));
     }
     if let Some(t) = o.sheet_thickness {
         positive(&key("sheet_thickness"), t)?;
