@@ -115,13 +115,6 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
     spinner.finish();
     let outcome = outcome.with_context(|| format!("precompute {}", args.mesh.display()))?;
     outcome.warnings.iter().filter(|w| !said.contains(*w)).for_each(|w| warn(w));
-    if outcome.bank.mode_count() == 0 {
-        warn(&format!(
-            "no mode between --min-freq {} Hz and --max-freq {} Hz: the bank is silent (a small or stiff object \
-             rings higher: raise --max-freq)",
-            args.min_freq, args.max_freq
-        ));
-    }
     let table = match args.transfer_max_freq {
         Some(f) => transfer(&outcome.bank, f)?,
         None => None,

@@ -331,7 +331,7 @@ pub fn precompute(
     if let (Some(cache), false) = (cache, force) {
         match cache.get(&key) {
             Ok(Some(bank)) => {
-                warnings.extend(residual_floor_warning(&bank));
+                warnings.extend(bank_warnings(request, &bank));
                 return Ok(Outcome { bank, cached: true, warnings });
             }
             Ok(None) => {}
@@ -361,7 +361,7 @@ pub fn precompute(
             (bank, level.is_some())
         }
     };
-    warnings.extend(residual_floor_warning(&bank));
+    warnings.extend(bank_warnings(request, &bank));
     // A mesh coarsened for this machine's memory is not the request's answer: another run,
     // with more memory, must not be served it from the cache.
     if let (Some(cache), false) = (cache, coarsened) {
@@ -371,6 +371,20 @@ pub fn precompute(
         }
     }
     Ok(Outcome { bank, cached: false, warnings })
+}
+
+/// What the user must hear about a finished bank, cached or solved: a
+/// residual floor, and a band with no mode in it (every caller, the batch
+/// catalogue included, says it; a silent prop must not pass as "ok").
+fn bank_warnings(request: &Request, bank: &ModeBank) -> Vec<String> {
+    let silent = (bank.mode_count() == 0).then(|| {
+        format!(
+            "no mode between {} Hz and {} Hz: the bank is silent (a small or stiff object rings higher: raise \
+             the highest frequency)",
+            request.min_freq_hz, request.max_freq_hz
+        )
+    });
+    residual_floor_warning(bank).into_iter().chain(silent).collect()
 }
 
 /// The residual every mode should reach (`‖Kw − λMw‖ / (λ‖Mw‖)`).
