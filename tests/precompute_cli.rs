@@ -441,3 +441,16 @@ fn surface_options_on_a_tet_mesh_are_named_not_dropped() {
         run.stderr
     );
 }
+
+#[test]
+fn a_thread_count_that_cannot_help_is_refused_before_any_work() {
+    // 100 000 threads stalled for over a minute before the solve; 0 was taken silently.
+    let dir = temp_dir();
+    let bar = example("bar_p1.msh");
+    for n in ["0", "100000"] {
+        let args =
+            ["precompute", bar.to_str().unwrap(), "-o", "b.bank", "--material", "steel", "--threads", n];
+        modal(dir.path(), &args).fails_with("--threads must be between 1 and 1024");
+        assert!(!dir.path().join("b.bank").exists());
+    }
+}

@@ -100,6 +100,9 @@ impl Request {
         if self.max_modes == 0 {
             return invalid("--modes must be at least 1".into());
         }
+        if let Some(n) = self.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+            return invalid(format!("--threads must be between 1 and {MAX_THREADS}, got {n}"));
+        }
         if let Some(a) = &self.accuracy {
             if !(a.target_pct.is_finite() && a.target_pct > 0.0) {
                 return invalid(format!(
@@ -117,6 +120,12 @@ impl Request {
         self.material.validate().map_err(|e| PrecomputeError::Invalid(e.to_string()))
     }
 }
+
+/// The most solver threads a request may ask for. More than the cores buys
+/// nothing (the solve is memory-bound beyond a few), and a pool of 10⁵
+/// threads stalled for over a minute before any work; the largest common
+/// machines have a few hundred cores.
+pub const MAX_THREADS: usize = 1024;
 
 /// Progress of the pipeline, for the CLI's progress display.
 #[derive(Clone, Debug, PartialEq)]
