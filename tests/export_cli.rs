@@ -150,6 +150,11 @@ fn faust_export_refuses_bad_input_and_leaves_nothing() {
         .fails_with("from the surface");
     modal(dir.path(), &["export", "bar.bank", "--faust", "x.lib", "--at", "0,0,0", "--faust-name", "9x"])
         .fails_with("not a Faust identifier");
+    // Names Faust would refuse only when the library is compiled: say why now.
+    modal(dir.path(), &["export", "bar.bank", "--faust", "x.lib", "--at", "0,0,0", "--faust-name", "ba"])
+        .fails_with("--faust-name: `ba` is a Faust standard library environment (stdfaust.lib)");
+    modal(dir.path(), &["export", "bar.bank", "--faust", "x.lib", "--at", "0,0,0", "--faust-name", "with"])
+        .fails_with("`with` is a Faust keyword");
     assert!(!dir.path().join("x.lib").exists());
     assert!(files_in(dir.path()).iter().all(|f| !f.ends_with(".tmp")));
     // --faust needs --at (a malformed command line: exit code 2).

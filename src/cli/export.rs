@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use modal_bank::ModeBank;
-use modal_export::faust::{FaustModel, DEFAULT_NAME};
+use modal_export::faust::{check_name, FaustModel, DEFAULT_NAME};
 use serde_json::{json, Value};
 
 use super::args::ExportArgs;
@@ -39,6 +39,7 @@ fn vtk(bank: &ModeBank, path: &Path) -> Result<Value> {
 
 fn faust(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
     let name = args.faust_name.as_deref().unwrap_or(DEFAULT_NAME);
+    check_name(name).context("--faust-name")?;
     let model = FaustModel::new(bank, &args.at, name).context("--faust")?;
     let source = args.bank.file_name().map_or_else(|| "a bank".into(), |n| n.to_string_lossy().into_owned());
     write_file(path, |w| Ok(model.write(w, &source)?))?;

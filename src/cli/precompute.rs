@@ -157,19 +157,22 @@ pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
     assembled.warnings.iter().for_each(|w| warn(w));
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create directory {}", args.out.display()))?;
-    let write = |name: &str, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| -> Result<()> {
-        let path = args.out.join(name);
-        write_atomic(&path, |tmp| {
-            let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-            f(&mut file)?;
-            std::io::Write::flush(&mut file)?;
-            Ok(())
-        })
-        .with_context(|| format!("cannot write {}", path.display()))
-    };
-    write("K.mtx", &|w| modal_fem::write_matrix_market(&assembled.k, w))?;
-    write("M.mtx", &|w| modal_fem::write_matrix_market(&assembled.m, w))?;
-    write("nodes.csv", &|w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))?;
+    let write =
+        |name: &str, f: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>| -> Result<()> {
+            let path = args.out.join(name);
+            write_atomic(&path, |tmp| {
+                let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+                f(&mut file)?;
+                std::io::Write::flush(&mut file)?;
+                Ok(())
+            })
+            .with_context(|| format!("cannot write {}", path.display()))
+        };
+    // The entries written, not the stored ones: the writer leaves out exact zeros.
+    let (mut nnz_k, mut nnz_m) = (0, 0);
+    write("K.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.k, w).map(|n| nnz_k = n))?;
+    write("M.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.m, w).map(|n| nnz_m = n))?;
+    write("nodes.csv", &mut |w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))?;
     let summary = serde_json::json!({
         "dir": args.out.display().to_string(),
         "nodes": assembled.mesh.nodes.len(),
@@ -177,7 +180,8 @@ pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
         "tets": assembled.mesh.cells.len(),
         "order": assembled.mesh.order(),
         "parts": assembled.parts,
-        "nnz_k": assembled.k.compute_nnz(),
+        "nnz_k": nnz_k,
+        "nnz_m": nnz_m,
         "assemble_s": assembled.assemble_s,
     });
     if args.json {

@@ -24,8 +24,15 @@ pub enum ExportError {
     #[error("the bank cannot be struck: {0}")]
     Bank(#[source] modal_synth::SynthError),
     /// A name that is not a Faust identifier.
-    #[error("'{0}' is not a Faust identifier (letters, digits and '_', not starting with a digit)")]
+    #[error("'{0}' is not a Faust identifier (letters, digits and '_', a letter first after any '_')")]
     Identifier(String),
+    /// A Faust keyword or primitive (or `process`), which no definition can be named after.
+    #[error("`{0}` is a Faust keyword; choose another name")]
+    FaustKeyword(String),
+    /// An environment of Faust's `stdfaust.lib`, which the generated library
+    /// imports, so the name would be defined twice.
+    #[error("`{0}` is a Faust standard library environment (stdfaust.lib); choose another name")]
+    FaustEnvironment(String),
     /// The bank fails its own validation.
     #[error("invalid bank: {0}")]
     InvalidBank(#[source] modal_bank::BankError),

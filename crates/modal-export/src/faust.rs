@@ -37,25 +37,24 @@ use crate::ExportError;
 /// The name mesh2faust gives its model.
 pub const DEFAULT_NAME: &str = "modalModel";
 
-/// Faust keywords and primitives a model must not be named after.
-const RESERVED: [&str; 16] = [
-    "process",
-    "with",
-    "letrec",
-    "where",
-    "import",
-    "component",
-    "library",
-    "environment",
-    "waveform",
-    "route",
-    "par",
-    "seq",
-    "sum",
-    "prod",
-    "case",
-    "declare",
-];
+/// The words Faust's lexer keeps for its keywords and primitives (the
+/// quoted words of `compiler/parser/faustlexer.l`, Faust 2.83; older
+/// releases keep a subset), which no definition can be named after, and
+/// `process`, the program's entry point, which the user's `.dsp` defines.
+const KEYWORDS: &str = "\
+    process with letrec where import component library environment waveform route declare case seq par \
+    sum prod inputs outputs mem prefix int float any rdtable rwtable select2 select3 ffunction fconstant \
+    fvariable button checkbox vslider hslider nentry vgroup hgroup tgroup vbargraph hbargraph soundfile \
+    attach minput enable control acos asin atan atan2 cos sin tan exp log log10 pow sqrt abs min max \
+    fmod remainder floor ceil rint round xor assertbounds lowest highest singleprecision doubleprecision \
+    quadprecision fixedpointprecision";
+
+/// The environments `import("stdfaust.lib")` defines (Faust libraries'
+/// `stdfaust.lib`, 2026; older releases define a subset). The generated
+/// library imports it, so a model named after one is a redefinition.
+const ENVIRONMENTS: &str = "\
+    aa sf an ba co db de dm dx en fd fi ho hy it la ma mi mo ef no os pf pl pm qu rm re ro sp si so sy \
+    ve vl wa wd";
 
 /// One excitation position: where it was asked for and where it landed.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,11 +90,32 @@ pub struct FaustModel {
     pub skipped_modes: usize,
 }
 
-/// Whether `name` can name a Faust definition.
+/// Whether `name` can name the model's Faust definition (see [`check_name`]).
 pub fn is_identifier(name: &str) -> bool {
-    let mut chars = name.chars();
-    let first_ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-    first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_') && !RESERVED.contains(&name)
+    check_name(name).is_ok()
+}
+
+/// Why `name` cannot name the model's Faust definition, if it cannot: not a
+/// Faust identifier (`_*[a-zA-Z][_a-zA-Z0-9]*`, as Faust's lexer reads
+/// one), a keyword, or an environment of the standard library.
+pub fn check_name(name: &str) -> Result<(), ExportError> {
+    let letters = name.trim_start_matches('_');
+    let identifier = letters.starts_with(|c: char| c.is_ascii_alphabetic())
+        && letters.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !identifier {
+        Err(ExportError::Identifier(name.to_string()))
+    } else if listed(KEYWORDS, name) {
+        Err(ExportError::FaustKeyword(name.to_string()))
+    } else if listed(ENVIRONMENTS, name) {
+        Err(ExportError::FaustEnvironment(name.to_string()))
+    } else {
+        Ok(())
+    }
+}
+
+/// Whether `word` is one of the space-separated `words`.
+fn listed(words: &str, word: &str) -> bool {
+    words.split_whitespace().any(|w| w == word)
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -105,9 +125,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 impl FaustModel {
     /// The model of `bank` excited at the points `at` \[m\], named `name`.
     pub fn new(bank: &ModeBank, at: &[[f64; 3]], name: &str) -> Result<FaustModel, ExportError> {
-        if !is_identifier(name) {
-            return Err(ExportError::Identifier(name.to_string()));
-        }
+        check_name(name)?;
         if at.is_empty() {
             return Err(ExportError::NoPositions);
         }
@@ -256,6 +274,29 @@ mod tests {
         assert!(!is_identifier("bar-1"));
         assert!(!is_identifier(""));
         assert!(!is_identifier("process"));
+    }
+
+    #[test]
+    fn keywords_and_standard_environments_are_refused_with_their_reason() {
+        assert!(is_identifier("__bar") && is_identifier("bar_") && is_identifier("bass"));
+        for name in ["_", "__", "_2", "a.b"] {
+            assert!(matches!(check_name(name), Err(ExportError::Identifier(_))), "{name}");
+        }
+        for name in ["process", "with", "min", "select2", "hslider", "waveform", "xor"] {
+            let error = check_name(name).unwrap_err();
+            assert!(matches!(error, ExportError::FaustKeyword(_)), "{name}");
+            assert_eq!(error.to_string(), format!("`{name}` is a Faust keyword; choose another name"));
+        }
+        for name in ["ba", "ma", "pm", "fi", "os", "sf", "wd", "la"] {
+            let error = check_name(name).unwrap_err();
+            assert!(matches!(error, ExportError::FaustEnvironment(_)), "{name}");
+            assert!(
+                error.to_string().contains("Faust standard library environment (stdfaust.lib)"),
+                "{error}"
+            );
+        }
+        let bank = SyntheticBank::preset("steel", 2).build();
+        assert!(matches!(FaustModel::new(&bank, &[[0.0; 3]], "ba"), Err(ExportError::FaustEnvironment(_))));
     }
 
     #[test]

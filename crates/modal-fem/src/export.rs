@@ -28,8 +28,10 @@ fn sci(v: f64) -> String {
 }
 
 /// Writes the lower triangle of the symmetric matrix `a` (full storage) in
-/// MatrixMarket coordinate real symmetric format.
-pub fn write_matrix_market(a: &SparseColMat<usize, f64>, out: impl Write) -> io::Result<()> {
+/// MatrixMarket coordinate real symmetric format, and returns the number of
+/// entries written (the size line's third number): the stored lower-triangle
+/// entries that are not exactly zero, not `a`'s stored count.
+pub fn write_matrix_market(a: &SparseColMat<usize, f64>, out: impl Write) -> io::Result<usize> {
     let mut out = io::BufWriter::new(out);
     let (symbolic, values) = a.parts();
     let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
@@ -43,7 +45,8 @@ pub fn write_matrix_market(a: &SparseColMat<usize, f64>, out: impl Write) -> io:
             writeln!(out, "{} {} {}", row_idx[p] + 1, j + 1, sci(values[p]))?;
         }
     }
-    out.flush()
+    out.flush()?;
+    Ok(count)
 }
 
 /// Writes node coordinates \[m\] as CSV with header `x,y,z`, full precision.

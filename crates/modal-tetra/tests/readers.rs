@@ -267,6 +267,21 @@ fn a_glb_scene_places_its_meshes_in_world_coordinates() {
 }
 
 #[test]
+fn a_gltf_reads_its_buffer_from_a_percent_encoded_relative_path() {
+    // Exporters percent-encode a space and point to shared buffers with `..`.
+    let sphere = shapes::icosphere(0.05, 1);
+    let (json, bin) = glb_chunks(&sphere, r#"[{"mesh":0}]"#, "[0]");
+    let json = json.replacen(r#""buffers":[{"#, r#""buffers":[{"uri":"../bins/bar%20data.bin","#, 1);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("model")).unwrap();
+    std::fs::create_dir_all(dir.path().join("bins")).unwrap();
+    std::fs::write(dir.path().join("bins/bar data.bin"), &bin).unwrap();
+    std::fs::write(dir.path().join("model/sphere.gltf"), json).unwrap();
+    let (s, _) = read_surface(dir.path().join("model/sphere.gltf"), 1.0, None).unwrap();
+    assert_eq!(s.triangles.len(), sphere.triangles.len());
+}
+
+#[test]
 fn a_quantized_glb_reads_like_the_float_one() {
     // gltfpack's default output: positions as normalized 16-bit integers
     // (KHR_mesh_quantization), scaled back by the node; and a required

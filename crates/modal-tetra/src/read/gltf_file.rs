@@ -13,17 +13,25 @@
 //! default: 8- or 16-bit integers, normalized or not, scaled back by the
 //! node's matrix) are read as the extension says; extensions a file
 //! requires for what is not geometry (textures, materials) do not stop it.
+//! Buffers are the GLB's binary chunk, `data:` URIs, or files named by
+//! relative, percent-encoded paths (see the `uri` module); of a file,
+//! only the declared `byteLength` is read.
 //! Refused with a clear error rather than read wrongly: compressed
 //! geometry (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`:
-//! decompress first), `data:` URI buffers, buffers shorter than declared,
-//! indices out of range, node hierarchies deeper than [`MAX_DEPTH`] (or
-//! cyclic), and every other error of the document's validation.
+//! decompress first), buffers shorter than declared, buffer URIs that are
+//! absolute or of another scheme, buffer paths that are not regular files
+//! (a device such as `/dev/zero` or a FIFO would be read without end, or
+//! waited on), indices out of range, node hierarchies deeper than
+//! [`MAX_DEPTH`] (or cyclic), and every other error of the document's
+//! validation.
 
+use std::io::Read;
 use std::path::Path;
 
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 
+use super::uri::{self, BufferUri};
 use crate::{TetraError, TriSurface};
 
 /// Deepest node hierarchy followed (a cycle would be endless).
@@ -94,12 +102,14 @@ fn with_compression_hint(bytes: &[u8], message: String) -> String {
 }
 
 /// Every buffer's bytes, in the document's order: buffer 0 may be the GLB's
-/// binary chunk, any buffer a file named by its URI relative to `base` (the
-/// folder of a `.gltf`; `None` refuses external files). `bytes` is the whole
-/// file, for the error's hint. Refused: a buffer other than 0 without a URI
-/// (a compressed file's fallback, which holds no data), `data:` URIs and
-/// buffers shorter than they declare. Shared by the geometry reader here and
-/// the bank import of `modal-export`, so both read a container alike.
+/// binary chunk, any buffer a `data:` URI or a file named by its URI relative
+/// to `base` (the folder of a `.gltf`; `None` refuses external files), of
+/// which the declared length is read. `bytes` is the whole file, for the
+/// error's hint. Refused: a buffer other than 0 without a URI (a compressed
+/// file's fallback, which holds no data), URIs that are neither relative
+/// paths nor `data:`, paths that are not regular files, and buffers shorter
+/// than they declare. Shared by the geometry reader here and the bank import
+/// of `modal-export`, so both read a container alike.
 pub fn gltf_buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Result<Vec<Vec<u8>>, TetraError> {
     doc.buffers()
         .map(|buffer| {
@@ -114,14 +124,7 @@ pub fn gltf_buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Resu
                     .blob
                     .clone()
                     .ok_or_else(|| bad("buffer 0 is the GLB's binary chunk, but there is none"))?,
-                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                    return Err(bad("data: URI buffers are not read (convert the file to .glb)"))
-                }
-                gltf::buffer::Source::Uri(uri) => {
-                    let base = base.ok_or_else(|| bad(format!("buffer '{uri}' is an external file")))?;
-                    let path = base.join(uri);
-                    std::fs::read(&path).map_err(|source| TetraError::Io { path, source })?
-                }
+                gltf::buffer::Source::Uri(uri) => uri_bytes(buffer.index(), uri, buffer.length(), base)?,
             };
             if data.len() < buffer.length() {
                 return Err(bad(format!(
@@ -134,6 +137,47 @@ pub fn gltf_buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Resu
             Ok(data)
         })
         .collect()
+}
+
+/// The bytes of buffer `index`, whose URI is `uri` and declared length `length`.
+fn uri_bytes(index: usize, uri: &str, length: usize, base: Option<&Path>) -> Result<Vec<u8>, TetraError> {
+    match uri::parse(uri).map_err(|why| bad(format!("buffer {index}: {why}")))? {
+        BufferUri::Data(data) => Ok(data),
+        BufferUri::Relative(relative) => {
+            let base = base.ok_or_else(|| bad(format!("buffer {index}: '{uri}' is an external file")))?;
+            read_prefix(index, &base.join(relative), length)
+        }
+    }
+}
+
+/// The first `length` bytes of the file `path` (buffer `index`). Its
+/// metadata is looked at before it is opened: a device such as `/dev/zero`
+/// would be read until memory runs out, a FIFO waited on, so only a regular
+/// file is read; and one shorter than `length` is refused before `length`
+/// bytes (declared by the file, so possibly absurd) are allocated.
+fn read_prefix(index: usize, path: &Path, length: usize) -> Result<Vec<u8>, TetraError> {
+    let io = |source| TetraError::Io { path: path.to_path_buf(), source };
+    let metadata = std::fs::metadata(path).map_err(io)?;
+    if !metadata.is_file() {
+        let kind = if metadata.is_dir() { "a directory" } else { "not a regular file" };
+        return Err(bad(format!("buffer {index}: {} is {kind}", path.display())));
+    }
+    let short = |size: u64| {
+        bad(format!("buffer {index}: file {} has {size} bytes, the glTF declares {length}", path.display()))
+    };
+    if metadata.len() < length as u64 {
+        return Err(short(metadata.len()));
+    }
+    let mut data = Vec::new();
+    data.try_reserve_exact(length)
+        .map_err(|_| bad(format!("buffer {index}: its {length} bytes do not fit in memory")))?;
+    let file = std::fs::File::open(path).map_err(io)?;
+    file.take(length as u64).read_to_end(&mut data).map_err(io)?;
+    // The file may have shrunk since its metadata was read.
+    if data.len() < length {
+        return Err(short(data.len() as u64));
+    }
+    Ok(data)
 }
 
 /// Adds the triangles of `node` and its children under the parent matrix `parent`.
@@ -306,5 +350,91 @@ mod tests {
         let world = multiply(&shift, &double);
         assert_eq!(transform(&world, [1.0, 1.0, 1.0]), [3.0, 4.0, 1.0]);
         assert!(determinant3(&world) < 0.0 && determinant3(&shift) > 0.0);
+    }
+
+    /// The buffers of a document whose one buffer has `uri` and declares
+    /// `length` bytes, its files looked up in `dir`.
+    fn buffers_of(uri: &str, length: u64, dir: &Path) -> Result<Vec<Vec<u8>>, TetraError> {
+        let document = serde_json::json!({
+            "asset": {"version": "2.0"},
+            "buffers": [{"uri": uri, "byteLength": length}]
+        });
+        let bytes = document.to_string().into_bytes();
+        gltf_buffers(&gltf::Gltf::from_slice(&bytes).unwrap(), Some(dir), &bytes)
+    }
+
+    /// The message of a refusal.
+    fn refusal(result: Result<Vec<Vec<u8>>, TetraError>) -> String {
+        match result {
+            Err(TetraError::Parse { format: "glTF", message }) => message,
+            other => panic!("expected a glTF error, got {other:?}"),
+        }
+    }
+
+    const TWELVE: &[u8; 12] = b"0123456789ab";
+
+    #[test]
+    fn percent_encoded_buffer_paths_are_decoded() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("bar data.bin"), TWELVE).unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        assert_eq!(buffers_of("bar%20data.bin", 12, dir.path()).unwrap(), [TWELVE]);
+        assert_eq!(buffers_of("../bar%20data.bin", 12, &dir.path().join("sub")).unwrap(), [TWELVE]);
+    }
+
+    #[test]
+    fn data_uri_buffers_are_decoded() {
+        let dir = tempfile::tempdir().unwrap();
+        for media in ["application/octet-stream", "application/gltf-buffer"] {
+            let uri = format!("data:{media};base64,MDEyMzQ1Njc4OWFi");
+            assert_eq!(buffers_of(&uri, 12, dir.path()).unwrap(), [TWELVE], "{media}");
+        }
+        let message = refusal(buffers_of("data:application/octet-stream;base64,MDEy", 12, dir.path()));
+        assert!(message.contains("holds 3 bytes, 12 declared"), "{message}");
+    }
+
+    #[test]
+    fn a_longer_buffer_file_is_read_to_its_declared_length() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a.bin"), TWELVE).unwrap();
+        assert_eq!(buffers_of("a.bin", 5, dir.path()).unwrap(), [&TWELVE[..5]]);
+    }
+
+    #[test]
+    fn a_shorter_buffer_file_is_refused_before_its_declared_length_is_allocated() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("a.bin");
+        std::fs::write(&file, TWELVE).unwrap();
+        for declared in [13, 1_000_000_000_000_000] {
+            let message = refusal(buffers_of("a.bin", declared, dir.path()));
+            let expected =
+                format!("buffer 0: file {} has 12 bytes, the glTF declares {declared}", file.display());
+            assert_eq!(message, expected);
+        }
+    }
+
+    #[test]
+    fn a_directory_is_refused_as_a_buffer() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        let message = refusal(buffers_of("sub", 12, dir.path()));
+        assert!(message.starts_with("buffer 0: ") && message.ends_with("sub is a directory"), "{message}");
+    }
+
+    /// `/dev/zero` would be read until memory runs out and a FIFO waited on
+    /// for a writer: both are refused before they are opened.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn devices_and_fifos_are_refused_without_reading_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let message = refusal(buffers_of("/dev/zero", 12, dir.path()));
+        assert!(message.contains("'/dev/zero' is an absolute path"), "{message}");
+        std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.bin")).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(dir.path().join("fifo.bin")).status().unwrap();
+        assert!(made.success());
+        for name in ["zero.bin", "fifo.bin"] {
+            let message = refusal(buffers_of(name, 12, dir.path()));
+            assert!(message.ends_with(&format!("{name} is not a regular file")), "{message}");
+        }
     }
 }

@@ -14,6 +14,7 @@ mod off;
 mod ply;
 mod polygon;
 mod stl;
+mod uri;
 
 pub use gltf_file::gltf_buffers;
 
