@@ -140,8 +140,8 @@ fn export_writes_a_vtu_and_matrices_are_lower_triangle() {
     }
     let nodes = std::fs::read_to_string(dir.path().join("m/nodes.csv")).unwrap();
     assert_eq!(nodes.lines().count() - 1, header[0] / 3);
-    // The counts reported are the entries written (exact zeros are left out).
-    for (file, field) in [("m/K.mtx", "nnz_k"), ("m/M.mtx", "nnz_m")] {
+    // `entries_k`/`entries_m` are the entries each file holds (exact zeros are left out).
+    for (file, field) in [("m/K.mtx", "entries_k"), ("m/M.mtx", "entries_m")] {
         let text = std::fs::read_to_string(dir.path().join(file)).unwrap();
         let mut lines = text.lines().filter(|l| !l.starts_with('%'));
         let declared: usize = lines.next().unwrap().split_whitespace().nth(2).unwrap().parse().unwrap();

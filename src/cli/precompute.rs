@@ -168,10 +168,11 @@ pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
             })
             .with_context(|| format!("cannot write {}", path.display()))
         };
-    // The entries written, not the stored ones: the writer leaves out exact zeros.
-    let (mut nnz_k, mut nnz_m) = (0, 0);
-    write("K.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.k, w).map(|n| nnz_k = n))?;
-    write("M.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.m, w).map(|n| nnz_m = n))?;
+    // The entries the files hold (the lower triangle without exact zeros), beside
+    // `nnz_k`, the assembled matrix's stored entries (both triangles).
+    let (mut entries_k, mut entries_m) = (0, 0);
+    write("K.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.k, w).map(|n| entries_k = n))?;
+    write("M.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.m, w).map(|n| entries_m = n))?;
     write("nodes.csv", &mut |w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))?;
     let summary = serde_json::json!({
         "dir": args.out.display().to_string(),
@@ -180,8 +181,9 @@ pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
         "tets": assembled.mesh.cells.len(),
         "order": assembled.mesh.order(),
         "parts": assembled.parts,
-        "nnz_k": nnz_k,
-        "nnz_m": nnz_m,
+        "nnz_k": assembled.k.compute_nnz(),
+        "entries_k": entries_k,
+        "entries_m": entries_m,
         "assemble_s": assembled.assemble_s,
     });
     if args.json {
