@@ -462,3 +462,70 @@ fn a_thread_count_that_cannot_help_is_refused_before_any_work() {
         assert!(!dir.path().join("b.bank").exists());
     }
 }
+
+/// A 10 × 5 × 3 cm box as a `.gltf` whose geometry is in `box.bin` next to it;
+/// `dent` moves the top of one corner down (1: a plain box).
+fn gltf_box_with_external_buffer(dir: &std::path::Path, dent: f32) {
+    let (x, y, z) = (0.1f32, 0.05f32, 0.03f32);
+    let v = [
+        [0., 0., 0.],
+        [x, 0., 0.],
+        [0., y, 0.],
+        [x, y, 0.],
+        [0., 0., z],
+        [x, 0., z],
+        [0., y, z],
+        [x, y, z * dent],
+    ];
+    let f: [[u16; 3]; 12] = [
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    let mut bin: Vec<u8> = v.iter().flatten().flat_map(|c: &f32| c.to_le_bytes()).collect();
+    let vertex_bytes = bin.len();
+    bin.extend(f.iter().flatten().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.join("box.bin"), &bin).unwrap();
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"uri": "box.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": vertex_bytes},
+            {"buffer": 0, "byteOffset": vertex_bytes, "byteLength": bin.len() - vertex_bytes}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [x, y, z]},
+            {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}
+        ]
+    });
+    std::fs::write(dir.join("box.gltf"), gltf.to_string()).unwrap();
+}
+
+#[test]
+fn a_gltf_whose_bin_file_changed_is_solved_again() {
+    // The cache key hashed the .gltf alone: after an artist re-exported the .bin,
+    // the old bank was served (even to a batch with --no-cache, from its --out).
+    let dir = temp_dir();
+    let solve = |dir: &std::path::Path| {
+        let args = ["precompute", "box.gltf", "-o", "b.bank", "--material", "steel", "--modes", "2"];
+        modal(dir, &[&args[..], &["--cell", "0.01", "--accuracy", "off", "--json"]].concat()).ok().json()
+    };
+    gltf_box_with_external_buffer(dir.path(), 1.0);
+    let plain = solve(dir.path());
+    assert_eq!(solve(dir.path())["cached"], true, "the same files: served from the cache");
+    gltf_box_with_external_buffer(dir.path(), 0.3);
+    let dented = solve(dir.path());
+    assert_eq!(dented["cached"], false);
+    let mass = |report: &serde_json::Value| report["mass_kg"].as_f64().unwrap();
+    assert!(mass(&dented) < 0.95 * mass(&plain), "{} kg against {} kg", mass(&dented), mass(&plain));
+}

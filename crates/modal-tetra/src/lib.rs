@@ -103,7 +103,7 @@ pub use mesher::{
     DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION, LAYERED_CELL_PER_WALL, LAYERED_MIN_CELLS_PER_WALL,
     LAYERED_STRAIGHT_CELL_PER_WALL,
 };
-pub use read::{gltf_buffers, parse_surface, read_surface, SurfaceFormat};
+pub use read::{gltf_buffers, gltf_uri_buffers, parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};
 pub use stuff::{ALPHA_LONG, ALPHA_SHORT};
 pub use surface::{write_obj, TriSurface};

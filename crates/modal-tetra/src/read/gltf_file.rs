@@ -139,6 +139,25 @@ pub fn gltf_buffers(doc: &gltf::Gltf, base: Option<&Path>, bytes: &[u8]) -> Resu
         .collect()
 }
 
+/// The bytes of the buffers the glTF file at `path` names by URI (files
+/// next to it, `data:` URIs), in the document's order; not the GLB's own
+/// binary chunk, which is part of the file. With the file's own bytes they
+/// are everything its geometry is read from: what a cache key must hash (a
+/// `.gltf` whose `.bin` was exported again is another mesh).
+pub fn gltf_uri_buffers(path: &Path) -> Result<Vec<Vec<u8>>, TetraError> {
+    let bytes = std::fs::read(path).map_err(|source| TetraError::Io { path: path.to_path_buf(), source })?;
+    let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| bad(e.to_string()))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    doc.buffers()
+        .filter_map(|buffer| match buffer.source() {
+            gltf::buffer::Source::Uri(uri) => {
+                Some(uri_bytes(buffer.index(), uri, buffer.length(), Some(base)))
+            }
+            gltf::buffer::Source::Bin => None,
+        })
+        .collect()
+}
+
 /// The bytes of buffer `index`, whose URI is `uri` and declared length `length`.
 fn uri_bytes(index: usize, uri: &str, length: usize, base: Option<&Path>) -> Result<Vec<u8>, TetraError> {
     match uri::parse(uri).map_err(|why| bad(format!("buffer {index}: {why}")))? {

@@ -16,7 +16,7 @@ mod polygon;
 mod stl;
 mod uri;
 
-pub use gltf_file::gltf_buffers;
+pub use gltf_file::{gltf_buffers, gltf_uri_buffers};
 
 use std::path::Path;
 
