@@ -4,7 +4,11 @@
 //! crates. An interrupt that arrives while no file is being written ends the
 //! process at once (exit code 130); one that arrives during a write lets
 //! that short write finish (so its temporary file is renamed or removed) and
-//! ends the process right after it.
+//! ends the process right after it. The writes counted are the CLI's own
+//! ([`guarded`]) and every library write through
+//! `modal_bank::write_file_atomically` (banks, cache entries, catalogues,
+//! written by a batch between its own steps), which refuses to start once
+//! the interrupt came.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::SeqCst};
 
@@ -16,11 +20,21 @@ fn exit_interrupted() -> ! {
     std::process::exit(130)
 }
 
+/// How long the handler waits for writes under way before it ends the
+/// process anyway (a write stuck on a dead network file system).
+const WRITE_WAIT: std::time::Duration = std::time::Duration::from_secs(30);
+
 /// Installs the SIGINT/SIGTERM handler (once, at start-up).
 pub fn install() {
     // If a handler cannot be installed, Ctrl-C keeps its default behaviour.
+    // The handler runs on its own thread, so it can wait for the writes.
     let _ = ctrlc::set_handler(|| {
         INTERRUPTED.store(true, SeqCst);
+        modal_bank::request_stop();
+        let start = std::time::Instant::now();
+        while modal_bank::writes_in_progress() > 0 && start.elapsed() < WRITE_WAIT {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
         if WRITES_IN_PROGRESS.load(SeqCst) == 0 {
             exit_interrupted();
         }

@@ -5,10 +5,52 @@
 //! see either the old file or the complete new one, concurrent writers of the
 //! same path each publish a complete file, and a failed write leaves nothing
 //! behind (the temporary file is deleted on drop).
+//!
+//! A process ended while a write is under way (`exit` runs no destructor)
+//! would leave the temporary file. So the writes in progress are counted,
+//! and a program that stops on a signal first calls [`request_stop`]: no
+//! write starts after it, and the program ends once
+//! [`writes_in_progress`] is zero (the CLI's SIGINT/SIGTERM handler).
 
 use crate::{BankError, ModeBank};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::SeqCst};
+
+static WRITES_IN_PROGRESS: AtomicUsize = AtomicUsize::new(0);
+static STOP_REQUESTED: AtomicBool = AtomicBool::new(false);
+
+/// Refuses every atomic write that has not started yet (it fails with
+/// [`std::io::ErrorKind::Interrupted`]); the ones under way finish.
+pub fn request_stop() {
+    STOP_REQUESTED.store(true, SeqCst);
+}
+
+/// Atomic writes under way in this process.
+pub fn writes_in_progress() -> usize {
+    WRITES_IN_PROGRESS.load(SeqCst)
+}
+
+/// Counts one write while it lives.
+struct WriteInProgress;
+
+impl WriteInProgress {
+    /// `None` once a stop was requested.
+    fn start() -> Option<WriteInProgress> {
+        WRITES_IN_PROGRESS.fetch_add(1, SeqCst);
+        if STOP_REQUESTED.load(SeqCst) {
+            WRITES_IN_PROGRESS.fetch_sub(1, SeqCst);
+            return None;
+        }
+        Some(WriteInProgress)
+    }
+}
+
+impl Drop for WriteInProgress {
+    fn drop(&mut self) {
+        WRITES_IN_PROGRESS.fetch_sub(1, SeqCst);
+    }
+}
 
 /// Writes `path` atomically: `write` fills a temporary file in the same
 /// directory (which must exist: a typo in a path is an error, not a new
@@ -21,6 +63,9 @@ pub fn write_file_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    let Some(_counted) = WriteInProgress::start() else {
+        return Err(std::io::Error::new(std::io::ErrorKind::Interrupted, "the program is stopping"));
+    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),

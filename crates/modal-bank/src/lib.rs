@@ -42,6 +42,6 @@ pub use damping::rayleigh;
 pub use deferred::DeferredBank;
 pub use error::BankError;
 pub use format::{FORMAT_NAME, FORMAT_VERSION, OLDEST_READABLE_VERSION};
-pub use fsio::write_file_atomically;
+pub use fsio::{request_stop, write_file_atomically, writes_in_progress};
 pub use radiation::{ModeTransfer, RadiationTable};
 pub use types::*;
