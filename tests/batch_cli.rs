@@ -427,9 +427,31 @@ fn manifest_and_merge_mistakes_are_one_clear_line() {
     )
     .ok();
     modal(d, &["catalogue", "merge", "out", "-o", "all.json"], &[]).fails_with("shard 1 of 2");
+    // The same when the shard catalogues are named as files (a shell glob).
+    let shard_file = "out/catalogue-shard-0-of-2.json";
+    modal(d, &["catalogue", "merge", shard_file, "-o", "all.json"], &[]).fails_with("shard 1 of 2");
     let partial = modal(d, &["catalogue", "merge", "out", "-o", "all.json", "--partial", "--json"], &[]).ok();
     assert_eq!(partial.json()["complete"], false);
     assert_eq!(load(&d.join("all.json"))["complete"], false);
+    // A library that resolves to nothing (a mount missing on this node) is an error,
+    // not a complete empty catalogue on every shard.
+    std::fs::write(d.join("nothing.toml"), "[[globs]]\npattern = \"absent/*.obj\"\nmaterial = \"steel\"\n")
+        .unwrap();
+    modal(d, &["precompute-batch", "nothing.toml", "--out", "none"], &[]).fails_with("resolves to no asset");
+    // A shard count without an index would run the whole library on every pod.
+    let count_only = [("MODAL_SHARD_COUNT", "8")];
+    modal(d, &["precompute-batch", "library.toml", "--out", "all"], &count_only)
+        .fails_with("needs a shard index");
+    // The memory guard's variable applies to a batch as to precompute.
+    let args = ["precompute-batch", "library.toml", "--out", "tight", "--cache-dir", "c2"];
+    modal(d, &args, &[("MODAL_MEMORY_LIMIT_GB", "banana")]).fails_with("MODAL_MEMORY_LIMIT_GB");
+    let tight = modal(d, &[&args[..], &["--json"]].concat(), &[("MODAL_MEMORY_LIMIT_GB", "0.000001")]);
+    assert_eq!(tight.code, Some(1), "{}", tight.stderr);
+    let tight = tight.json();
+    assert!(!entries(&tight).is_empty());
+    for entry in entries(&tight) {
+        assert!(entry["status"].as_str().unwrap().contains("memory"), "{entry}");
+    }
 }
 
 /// Banks of surface meshes carry the per-mode error estimate like `modal precompute`'s

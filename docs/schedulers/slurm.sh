@@ -4,8 +4,11 @@
 #   sbatch docs/schedulers/slurm.sh library.toml /shared/banks
 #
 # Every array task runs one shard: modal reads SLURM_ARRAY_TASK_ID,
-# SLURM_ARRAY_TASK_MIN and SLURM_ARRAY_TASK_COUNT itself (shard =
-# TASK_ID - TASK_MIN, of TASK_COUNT), so the --array range may start at 0 or 1.
+# SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_STEP and SLURM_ARRAY_TASK_COUNT itself
+# (shard = (TASK_ID - TASK_MIN) / TASK_STEP, of TASK_COUNT), so the --array
+# range may start at 0 or 1 and have a step (0-14:2); a list (3,5,7) is refused.
+# The job's --mem is not what modal sees as free memory: set
+# MODAL_MEMORY_LIMIT_GB below it, so an asset too large fails alone.
 # All tasks write into one output directory (each its own
 # catalogue-shard-I-of-N.json) and share one cache on the shared file system:
 # a re-submitted or requeued task skips what is already finished.
@@ -24,6 +27,8 @@ MANIFEST=${1:?usage: sbatch slurm.sh MANIFEST OUT_DIR}
 OUT=${2:?usage: sbatch slurm.sh MANIFEST OUT_DIR}
 # One cache for all tasks, on the shared file system (atomic renames, no locks).
 export MODAL_CACHE_DIR=${MODAL_CACHE_DIR:-$OUT/.cache}
+# The memory guard: 3 of the job's 4 GB (--mem above).
+export MODAL_MEMORY_LIMIT_GB=${MODAL_MEMORY_LIMIT_GB:-3}
 
 # One asset at a time per task, two solver threads (the --cpus-per-task above).
 # Exit code 1 means some assets failed: the task is marked FAILED, the good

@@ -11,7 +11,7 @@ use modal_batch::{BatchOptions, Catalogue, Event, Manifest, Shard, ShardEnv};
 use serde::Serialize;
 
 use super::output::{print_json, warn};
-use super::precompute::open_cache;
+use super::precompute::{memory_limit_from_env, open_cache};
 
 /// Precompute the mode banks of every asset in a manifest (one shard of it).
 #[derive(Debug, Args)]
@@ -71,10 +71,21 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     }
     let (shard, from) =
         Shard::select(args.shard.as_deref(), args.shard_count, |name| std::env::var(name).ok())?;
+    // The memory guard of `modal precompute`: in a pod or a Slurm job the
+    // machine's free memory is not the job's limit.
+    let memory_limit = memory_limit_from_env()?;
     let manifest = Manifest::load(&args.manifest)?;
     let (all, warnings) = manifest.resolve()?;
     warnings.iter().for_each(|w| warn(w));
-    let assets: Vec<_> = all.into_iter().filter(|a| shard.owns(&a.bank)).collect();
+    // A library that resolves to nothing (a mount missing on this node) must not
+    // pass as a complete, empty batch on every shard.
+    if all.is_empty() {
+        bail!("{}: the manifest resolves to no asset", args.manifest.display());
+    }
+    let mut assets: Vec<_> = all.into_iter().filter(|a| shard.owns(&a.bank)).collect();
+    if memory_limit.is_some() {
+        assets.iter_mut().for_each(|a| a.request.memory_limit_bytes = memory_limit);
+    }
     let selection = match from {
         ShardEnv::Whole => String::new(),
         ShardEnv::Flag => format!("shard {shard} (--shard): "),

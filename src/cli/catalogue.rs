@@ -8,6 +8,10 @@ use serde::Serialize;
 
 use super::output::{print_json, warn};
 
+/// Missing shards named in a message; the rest are counted (a count of 10⁵
+/// shards would print 10⁵ lines).
+const MISSING_LISTED: usize = 10;
+
 /// Work with batch catalogues.
 #[derive(Debug, Subcommand)]
 pub enum CatalogueCommand {
@@ -54,7 +58,10 @@ fn merge(args: MergeArgs) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let (merged, report) = modal_batch::merge(&args.inputs, out_dir)?;
     if !merged.complete && !args.partial {
-        let mut why = report.missing.clone();
+        let mut why: Vec<String> = report.missing.iter().take(MISSING_LISTED).cloned().collect();
+        if report.missing.len() > MISSING_LISTED {
+            why.push(format!("and {} more missing shards", report.missing.len() - MISSING_LISTED));
+        }
         if !merged.pending.is_empty() {
             why.push(format!("{} assets unfinished (e.g. {})", merged.pending.len(), merged.pending[0]));
         }
@@ -66,7 +73,10 @@ fn merge(args: MergeArgs) -> Result<()> {
             why.join("; ")
         );
     }
-    report.missing.iter().for_each(|m| warn(&format!("missing {m}")));
+    report.missing.iter().take(MISSING_LISTED).for_each(|m| warn(&format!("missing {m}")));
+    if report.missing.len() > MISSING_LISTED {
+        warn(&format!("and {} more missing shards", report.missing.len() - MISSING_LISTED));
+    }
     merged.save(&args.out)?;
     let summary = MergeJson {
         catalogue: args.out.display().to_string(),

@@ -162,27 +162,31 @@ impl Catalogue {
 pub struct MergeReport {
     /// The catalogue files read.
     pub inputs: Vec<PathBuf>,
-    /// Shards missing from a directory (`"DIR: shard I of N"`).
+    /// Shards no input catalogue is from (`"shard I of N"`).
     pub missing: Vec<String>,
 }
 
 /// Joins catalogues into one whose banks are relative to `out_dir`.
 ///
 /// Each input is a catalogue file, or a directory whose
-/// `catalogue-shard-I-of-N.json` files are all read (they must agree on N;
-/// the absent indices are reported in [`MergeReport::missing`]), or, with no
-/// shard files, its `catalogue.json`. Entries that agree on everything but
-/// `seconds`/`cached` are kept once; two different results for one bank
-/// file are an error (mixed runs in one directory). The result is complete
-/// when every input was and no shard is missing.
+/// `catalogue-shard-I-of-N.json` files are all read, or, with no shard
+/// files, its `catalogue.json`. The shard catalogues read, named as files
+/// or found in directories, must agree on N; the indices none of them is
+/// from are reported in [`MergeReport::missing`] (an unsharded or merged
+/// catalogue among the inputs covers every shard). Entries that agree on
+/// everything but `seconds`/`cached` are kept once; two different results
+/// for one bank file are an error (mixed runs in one directory). The result
+/// is complete when every input was and no shard is missing.
 pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeReport), BatchError> {
     let mut report = MergeReport::default();
     let mut entries = Vec::new();
     let mut pending = Vec::new();
     let mut complete = true;
+    let mut shards = ShardCoverage::default();
     for input in inputs {
-        for file in catalogue_files(input, &mut report.missing)? {
+        for file in catalogue_files(input)? {
             let catalogue = Catalogue::load(&file)?;
+            shards.add(catalogue.shard, &file)?;
             let dir = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
             complete &= catalogue.complete;
             pending.extend(catalogue.pending);
@@ -198,6 +202,7 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
     if report.inputs.is_empty() {
         return Err(BatchError::Catalogue { path: "(none)".into(), message: "no catalogue to merge".into() });
     }
+    report.missing = shards.missing();
     entries.sort_by(|a, b| a.sort_key().cmp(&b.sort_key()).then(a.seconds.total_cmp(&b.seconds)));
     entries.dedup_by(|later, first| later.result() == first.result());
     let mut by_bank: BTreeMap<&str, &CatalogueEntry> = BTreeMap::new();
@@ -222,8 +227,54 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
     Ok((merged, report))
 }
 
+/// Which shards the merged catalogues are from.
+#[derive(Default)]
+struct ShardCoverage {
+    /// The shard count and the file that set it.
+    count: Option<(usize, PathBuf)>,
+    /// Indices seen.
+    seen: std::collections::BTreeSet<usize>,
+    /// An unsharded (or already merged) catalogue was read: it covers all.
+    whole: bool,
+}
+
+impl ShardCoverage {
+    /// Records the shard of the catalogue `file`; shard counts must agree.
+    fn add(&mut self, shard: Option<ShardInfo>, file: &Path) -> Result<(), BatchError> {
+        let Some(ShardInfo { index, count }) = shard else {
+            self.whole = true;
+            return Ok(());
+        };
+        match &self.count {
+            Some((n, first)) if *n != count => {
+                return Err(BatchError::Catalogue {
+                    path: file.display().to_string(),
+                    message: format!(
+                    "is shard {index} of {count}, but {} is of {n} shards: merge the catalogues of one run",
+                    first.display()
+                ),
+                })
+            }
+            Some(_) => {}
+            None => self.count = Some((count, file.to_path_buf())),
+        }
+        self.seen.insert(index);
+        Ok(())
+    }
+
+    /// The shards no catalogue is from (none when a whole one was read).
+    fn missing(&self) -> Vec<String> {
+        match (&self.count, self.whole) {
+            (Some((n, _)), false) => {
+                (0..*n).filter(|i| !self.seen.contains(i)).map(|i| format!("shard {i} of {n}")).collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+}
+
 /// The catalogue files an input stands for (see [`merge`]).
-fn catalogue_files(input: &Path, missing: &mut Vec<String>) -> Result<Vec<PathBuf>, BatchError> {
+fn catalogue_files(input: &Path) -> Result<Vec<PathBuf>, BatchError> {
     let bad = |message: String| BatchError::Catalogue { path: input.display().to_string(), message };
     if !input.is_dir() {
         return if input.is_file() {
@@ -256,17 +307,12 @@ fn catalogue_files(input: &Path, missing: &mut Vec<String>) -> Result<Vec<PathBu
             counts.join(", ")
         )));
     }
-    let (count, files) = shards.into_iter().next().expect("one shard count");
-    missing.extend(
-        (0..count)
-            .filter(|i| !files.contains_key(i))
-            .map(|i| format!("{}: shard {i} of {count}", input.display())),
-    );
+    let (_, files) = shards.into_iter().next().expect("one shard count");
     Ok(files.into_values().collect())
 }
 
 /// `(I, N)` of a `catalogue-shard-I-of-N.json` name with `I < N`.
-fn parse_shard_name(name: &str) -> Option<(usize, usize)> {
+pub(crate) fn parse_shard_name(name: &str) -> Option<(usize, usize)> {
     let middle = name.strip_prefix("catalogue-shard-")?.strip_suffix(".json")?;
     let (i, n) = middle.split_once("-of-")?;
     let (i, n) = (i.parse().ok()?, n.parse().ok()?);
@@ -359,6 +405,22 @@ mod tests {
         assert_eq!(report.missing.len(), 1);
         assert!(report.missing[0].contains("shard 0 of 3"));
         assert!(!partial.complete);
+        // Named as files, the shards are checked alike: shards 1 and 2 of 3 are not all.
+        let file = |i| dir.path().join(Catalogue::file_name(Shard::new(i, count).unwrap()));
+        let (files, report) = merge(&[file(1), file(2)], dir.path()).unwrap();
+        assert_eq!(report.missing, ["shard 0 of 3"]);
+        assert!(!files.complete);
+        // An unsharded catalogue covers every shard.
+        let whole_file = dir.path().join("whole.json");
+        whole.save(&whole_file).unwrap();
+        let (covered, report) = merge(&[file(1), whole_file], dir.path()).unwrap();
+        assert!(report.missing.is_empty() && covered.complete);
+        // A shard of another count is another run.
+        let other = Shard::new(0, 5).unwrap();
+        let other_file = dir.path().join("other").join(Catalogue::file_name(other));
+        Catalogue::new(vec![], vec![], other).save(&other_file).unwrap();
+        let err = merge(&[file(1), other_file], dir.path()).unwrap_err().to_string();
+        assert!(err.contains("of 5") && err.contains("of 3 shards"), "{err}");
     }
 
     #[test]

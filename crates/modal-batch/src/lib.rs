@@ -33,8 +33,8 @@ mod shard;
 pub use catalogue::{merge, Catalogue, CatalogueEntry, MergeReport, ShardInfo, CATALOGUE_FILE};
 pub use glob::{expand as expand_glob, Pattern};
 pub use manifest::{Accuracy, Asset, Manifest, Options};
-pub use run::{run_asset, run_batch, BatchOptions, Event};
-pub use shard::{Shard, ShardEnv, SHARD_COUNT_ENV};
+pub use run::{run_asset, run_batch, BatchOptions, Event, SNAPSHOT_INTERVAL};
+pub use shard::{Shard, ShardEnv, MAX_SHARDS, SHARD_COUNT_ENV};
 
 /// Everything that can stop a batch before it starts, or a merge.
 #[derive(Debug, thiserror::Error)]

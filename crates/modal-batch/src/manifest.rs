@@ -442,6 +442,10 @@ fn check_bank_name(name: &str) -> Result<String, String> {
     if n.is_empty() || escapes {
         return Err(format!("`bank = \"{name}\"` must be a relative path inside the output directory"));
     }
+    // The catalogue would overwrite the bank (and be listed as it).
+    if n == crate::CATALOGUE_FILE || crate::catalogue::parse_shard_name(&n).is_some() {
+        return Err(format!("`bank = \"{name}\"` is the name of the batch's catalogue: choose another"));
+    }
     Ok(n)
 }
 
@@ -571,6 +575,14 @@ mod tests {
         assert!(assets.is_empty());
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("matches no file"));
+    }
+
+    #[test]
+    fn a_bank_may_not_take_the_catalogue_s_name() {
+        for name in ["catalogue.json", "catalogue-shard-1-of-3.json", "./catalogue.json"] {
+            assert!(check_bank_name(name).unwrap_err().contains("catalogue"), "{name}");
+        }
+        assert_eq!(check_bank_name("sub/catalogue.json").unwrap(), "sub/catalogue.json");
     }
 
     #[test]

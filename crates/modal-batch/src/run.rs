@@ -13,14 +13,17 @@
 //! (format 2). Any error, even a panic, becomes the asset's catalogue
 //! `status`; the batch goes on.
 //!
-//! The catalogue is rewritten atomically after every asset, listing the
+//! The catalogue is rewritten atomically as assets finish, listing the
 //! assets not finished yet under `pending`, so a killed run leaves an honest
-//! partial catalogue behind.
+//! partial catalogue behind: at most every [`SNAPSHOT_INTERVAL`] (rewriting
+//! it after each of 3 000 instant assets wrote 1.9 GB), and at the end. A
+//! run killed in between lists its last assets as pending; a re-run finds
+//! their banks finished.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use modal_bank::{BankCache, ModeBank};
 use modal_precompute::cache_key;
@@ -28,6 +31,9 @@ use modal_radiation::modes::{audible_modes, is_transfer_table_of, transfer_table
 use modal_radiation::RadiationOptions;
 
 use crate::{Asset, BatchError, Catalogue, CatalogueEntry, Shard};
+
+/// The shortest time between two rewrites of the catalogue during a run.
+pub const SNAPSHOT_INTERVAL: Duration = Duration::from_secs(2);
 
 /// How to run a batch.
 #[derive(Clone, Debug)]
@@ -80,8 +86,9 @@ pub fn run_batch(
         done: Vec<CatalogueEntry>,
         pending: Vec<String>,
         write_error: Option<BatchError>,
+        saved: Instant,
     }
-    let state = Mutex::new(State { done: Vec::new(), pending, write_error: None });
+    let state = Mutex::new(State { done: Vec::new(), pending, write_error: None, saved: Instant::now() });
     let next = AtomicUsize::new(0);
     let worker = || loop {
         let i = next.fetch_add(1, Ordering::Relaxed);
@@ -94,9 +101,12 @@ pub fn run_batch(
             if let Some(at) = s.pending.iter().position(|p| *p == asset.path) {
                 s.pending.remove(at);
             }
-            let snapshot = Catalogue::new(s.done.clone(), s.pending.clone(), options.shard);
-            if let Err(e) = snapshot.save(&path) {
-                s.write_error.get_or_insert(e);
+            if s.saved.elapsed() >= SNAPSHOT_INTERVAL {
+                let snapshot = Catalogue::new(s.done.clone(), s.pending.clone(), options.shard);
+                if let Err(e) = snapshot.save(&path) {
+                    s.write_error.get_or_insert(e);
+                }
+                s.saved = Instant::now();
             }
         }
         on_event(Event::Finished { asset, entry: &entry });

@@ -11,11 +11,18 @@
 //!
 //! Without `--shard`, the shard comes from the scheduler's environment
 //! ([`Shard::from_env`]):
-//! - Slurm job arrays: index `SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN`
-//!   (0 when `MIN` is unset), count `SLURM_ARRAY_TASK_COUNT`;
+//! - Slurm job arrays: index `(SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN)
+//!   / SLURM_ARRAY_TASK_STEP` (`MIN` 0 and `STEP` 1 when unset; `--array=0-14:2`
+//!   runs shards 0..7), count `SLURM_ARRAY_TASK_COUNT`; an index list
+//!   (`--array=3,5,7`) has no such mapping and is refused;
 //! - Kubernetes Indexed Jobs: index `JOB_COMPLETION_INDEX`, count from
 //!   `--shard-count` or `MODAL_SHARD_COUNT` (Kubernetes does not export it);
-//! - otherwise the whole manifest (shard 0 of 1).
+//! - otherwise the whole manifest (shard 0 of 1); a shard count without
+//!   an index (`MODAL_SHARD_COUNT` alone: an Indexed Job without
+//!   `completionMode: Indexed`) is an error, not the whole manifest on
+//!   every pod.
+//!
+//! At most [`MAX_SHARDS`] shards.
 //!
 //! `--shard-count`, when given, overrides any count from the environment.
 
@@ -48,6 +55,11 @@ pub enum ShardEnv {
 /// Environment variable giving the shard count to Kubernetes Indexed Jobs.
 pub const SHARD_COUNT_ENV: &str = "MODAL_SHARD_COUNT";
 
+/// The most shards a batch may be split into: more than a library's assets
+/// leaves shards empty, and a merge lists every missing shard (10¹⁷ shards
+/// ran a merge out of memory).
+pub const MAX_SHARDS: usize = 100_000;
+
 impl Shard {
     /// The whole manifest: shard 0 of 1.
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
@@ -56,6 +68,9 @@ impl Shard {
     pub fn new(index: usize, count: usize) -> Result<Shard, BatchError> {
         if count == 0 {
             return Err(BatchError::Shard("the shard count must be at least 1".into()));
+        }
+        if count > MAX_SHARDS {
+            return Err(BatchError::Shard(format!("{count} shards: at most {MAX_SHARDS} are supported")));
         }
         if index >= count {
             return Err(BatchError::Shard(format!(
@@ -124,9 +139,24 @@ impl Shard {
                     ))
                 }
             };
-            let index = id.checked_sub(min).ok_or_else(|| {
+            let offset = id.checked_sub(min).ok_or_else(|| {
                 BatchError::Shard(format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}"))
             })?;
+            let step = number("SLURM_ARRAY_TASK_STEP")?.unwrap_or(1).max(1);
+            if offset % step != 0 {
+                return Err(BatchError::Shard(format!(
+                    "SLURM_ARRAY_TASK_ID {id} is not SLURM_ARRAY_TASK_MIN {min} plus a multiple of \
+                     SLURM_ARRAY_TASK_STEP {step}: an array given as a list of indices has no shard \
+                     mapping; use a range (--array=0-N or 0-N:S) or --shard I/N"
+                )));
+            }
+            let index = offset / step;
+            if index >= n {
+                return Err(BatchError::Shard(format!(
+                    "SLURM_ARRAY_TASK_ID {id} is shard {index} of SLURM_ARRAY_TASK_COUNT {n}: an array given \
+                     as a list of indices has no shard mapping; use a range (--array=0-N or 0-N:S) or --shard I/N"
+                )));
+            }
             return Ok((Shard::new(index, n)?, ShardEnv::Slurm));
         }
         if let Some(index) = number("JOB_COMPLETION_INDEX")? {
@@ -138,9 +168,14 @@ impl Shard {
             })?;
             return Ok((Shard::new(index, n)?, ShardEnv::Kubernetes));
         }
-        match count {
-            Some(n) if n != 1 => Err(BatchError::Shard(format!(
+        match (count, count_from_env) {
+            (Some(n), _) if n != 1 => Err(BatchError::Shard(format!(
                 "--shard-count {n} needs a shard index: --shard I/{n}, SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX"
+            ))),
+            (None, Some(n)) if n != 1 => Err(BatchError::Shard(format!(
+                "{SHARD_COUNT_ENV}={n} needs a shard index (JOB_COMPLETION_INDEX: a Kubernetes Job with \
+                 completionMode: Indexed, SLURM_ARRAY_TASK_ID, or --shard I/{n}); without one every \
+                 worker would run the whole manifest"
             ))),
             _ => Ok((Shard::WHOLE, ShardEnv::Whole)),
         }
@@ -215,6 +250,36 @@ mod tests {
         assert!(Shard::select(None, None, env(&vars)).is_err(), "id 4 of 4 without MIN is out of range");
         assert!(Shard::select(None, None, env(&[("SLURM_ARRAY_TASK_ID", "0")])).is_err());
         assert!(Shard::select(None, None, env(&[("SLURM_ARRAY_TASK_ID", "x")])).is_err());
+    }
+
+    #[test]
+    fn slurm_steps_are_followed_and_index_lists_refused() {
+        // --array=0-14:2: ids 0, 2, ..., 14 are shards 0..=7 of 8.
+        let stepped = |id: &'static str| {
+            [
+                ("SLURM_ARRAY_TASK_ID", id),
+                ("SLURM_ARRAY_TASK_MIN", "0"),
+                ("SLURM_ARRAY_TASK_STEP", "2"),
+                ("SLURM_ARRAY_TASK_COUNT", "8"),
+            ]
+        };
+        assert_eq!(Shard::select(None, None, env(&stepped("6"))).unwrap().0, Shard::new(3, 8).unwrap());
+        assert_eq!(Shard::select(None, None, env(&stepped("14"))).unwrap().0, Shard::new(7, 8).unwrap());
+        assert!(Shard::select(None, None, env(&stepped("5"))).is_err(), "not on the step");
+        // --array=3,5,7: MIN 3, COUNT 3, no step: id 7 would be shard 4 of 3.
+        let list =
+            [("SLURM_ARRAY_TASK_ID", "7"), ("SLURM_ARRAY_TASK_MIN", "3"), ("SLURM_ARRAY_TASK_COUNT", "3")];
+        let err = Shard::select(None, None, env(&list)).unwrap_err().to_string();
+        assert!(err.contains("list of indices"), "{err}");
+    }
+
+    #[test]
+    fn a_shard_count_alone_is_an_error_and_absurd_counts_are_refused() {
+        let err = Shard::select(None, None, env(&[(SHARD_COUNT_ENV, "8")])).unwrap_err().to_string();
+        assert!(err.contains("needs a shard index"), "{err}");
+        assert_eq!(Shard::select(None, None, env(&[(SHARD_COUNT_ENV, "1")])).unwrap().0, Shard::WHOLE);
+        assert!(Shard::parse("0/99999999999999999").is_err());
+        assert!(Shard::new(0, MAX_SHARDS).is_ok() && Shard::new(0, MAX_SHARDS + 1).is_err());
     }
 
     #[test]
