@@ -86,51 +86,70 @@ fn match_name(pattern: &str, name: &str) -> bool {
 /// `/`-separated relative paths. Symbolic links to files are followed;
 /// symbolic links to directories are not descended by `**` (no cycles).
 pub fn expand(base: &Path, pattern: &Pattern) -> Result<Vec<String>, BatchError> {
-    let mut found = Vec::new();
-    walk(base, &mut Vec::new(), &pattern.segments, &mut found)?;
-    found.sort();
-    found.dedup();
-    Ok(found)
+    Ok(expand_reporting(base, pattern)?.0)
 }
 
-fn walk(
-    base: &Path,
-    prefix: &mut Vec<String>,
-    pattern: &[String],
-    found: &mut Vec<String>,
-) -> Result<(), BatchError> {
-    let Some((seg, rest)) = pattern.split_first() else { return Ok(()) };
-    let dir: PathBuf = prefix.iter().fold(base.to_path_buf(), |d, p| d.join(p));
-    if seg == "**" {
-        walk(base, prefix, rest, found)?;
-        for (name, kind) in entries(&dir)? {
-            if kind == Kind::Dir && !name.starts_with('.') {
-                prefix.push(name);
-                walk(base, prefix, pattern, found)?;
-                prefix.pop();
-            }
-        }
-        return Ok(());
+/// [`expand`], and the names it could not match because they are not
+/// UTF-8 (a manifest's paths and bank names are text), lossily, sorted.
+pub fn expand_reporting(base: &Path, pattern: &Pattern) -> Result<(Vec<String>, Vec<String>), BatchError> {
+    let mut walker = Walk { base, found: Vec::new(), not_utf8: Vec::new() };
+    walker.walk(&mut Vec::new(), &pattern.segments)?;
+    for list in [&mut walker.found, &mut walker.not_utf8] {
+        list.sort();
+        list.dedup();
     }
-    for (name, kind) in entries(&dir)? {
-        if !match_name(seg, &name) {
-            continue;
-        }
-        match (rest.is_empty(), kind) {
-            (true, Kind::File) => {
-                let mut parts = prefix.clone();
-                parts.push(name);
-                found.push(parts.join("/"));
-            }
-            (false, Kind::Dir | Kind::LinkDir) => {
-                prefix.push(name);
-                walk(base, prefix, rest, found)?;
-                prefix.pop();
-            }
-            _ => {}
-        }
+    Ok((walker.found, walker.not_utf8))
+}
+
+/// A pattern's walk under `base`: the files found, the names skipped.
+struct Walk<'a> {
+    base: &'a Path,
+    found: Vec<String>,
+    not_utf8: Vec<String>,
+}
+
+impl Walk<'_> {
+    /// The entries of `dir`, noting the names that are not UTF-8.
+    fn entries(&mut self, dir: &Path) -> Result<Vec<(String, Kind)>, BatchError> {
+        let (entries, not_utf8) = entries(dir)?;
+        self.not_utf8.extend(not_utf8.into_iter().map(|name| dir.join(name).display().to_string()));
+        Ok(entries)
     }
-    Ok(())
+
+    fn walk(&mut self, prefix: &mut Vec<String>, pattern: &[String]) -> Result<(), BatchError> {
+        let Some((seg, rest)) = pattern.split_first() else { return Ok(()) };
+        let dir: PathBuf = prefix.iter().fold(self.base.to_path_buf(), |d, p| d.join(p));
+        if seg == "**" {
+            self.walk(prefix, rest)?;
+            for (name, kind) in self.entries(&dir)? {
+                if kind == Kind::Dir && !name.starts_with('.') {
+                    prefix.push(name);
+                    self.walk(prefix, pattern)?;
+                    prefix.pop();
+                }
+            }
+            return Ok(());
+        }
+        for (name, kind) in self.entries(&dir)? {
+            if !match_name(seg, &name) {
+                continue;
+            }
+            match (rest.is_empty(), kind) {
+                (true, Kind::File) => {
+                    let mut parts = prefix.clone();
+                    parts.push(name);
+                    self.found.push(parts.join("/"));
+                }
+                (false, Kind::Dir | Kind::LinkDir) => {
+                    prefix.push(name);
+                    self.walk(prefix, rest)?;
+                    prefix.pop();
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -142,19 +161,25 @@ enum Kind {
     Other,
 }
 
-/// The entries of `dir` with their kinds; a missing directory has none.
-fn entries(dir: &Path) -> Result<Vec<(String, Kind)>, BatchError> {
+/// A directory's entries with their kinds, and the names that are not UTF-8.
+type Listing = (Vec<(String, Kind)>, Vec<std::ffi::OsString>);
+
+/// The entries of `dir`; a missing directory has none.
+fn entries(dir: &Path) -> Result<Listing, BatchError> {
     let read_err = |source| BatchError::Read { path: dir.display().to_string(), source };
     let rd = match std::fs::read_dir(dir) {
         Ok(rd) => rd,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => return Ok(Vec::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Default::default()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => return Ok(Default::default()),
         Err(e) => return Err(read_err(e)),
     };
-    let mut out = Vec::new();
+    let (mut out, mut not_utf8) = (Vec::new(), Vec::new());
     for entry in rd {
         let entry = entry.map_err(read_err)?;
-        let Some(name) = entry.file_name().to_str().map(str::to_string) else { continue };
+        let Some(name) = entry.file_name().to_str().map(str::to_string) else {
+            not_utf8.push(entry.file_name());
+            continue;
+        };
         let link = entry.file_type().is_ok_and(|t| t.is_symlink());
         let kind = match std::fs::metadata(entry.path()) {
             Ok(m) if m.is_file() => Kind::File,
@@ -165,7 +190,7 @@ fn entries(dir: &Path) -> Result<Vec<(String, Kind)>, BatchError> {
         out.push((name, kind));
     }
     out.sort();
-    Ok(out)
+    Ok((out, not_utf8))
 }
 
 #[cfg(test)]
@@ -219,5 +244,21 @@ mod tests {
             assert_eq!(all.contains(&f.to_string()), deep.matches(f), "{f}");
         }
         assert!(expand(dir.path(), &Pattern::new("none/*.obj").unwrap()).unwrap().is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn names_that_are_not_utf8_are_reported_not_dropped_silently() {
+        use std::os::unix::ffi::OsStrExt;
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("good.msh"), b"").unwrap();
+        let latin1 = std::ffi::OsStr::from_bytes(b"caf\xe9.msh");
+        if std::fs::write(dir.path().join(latin1), b"").is_err() {
+            return; // a file system that refuses such names has none to report
+        }
+        let (found, not_utf8) = expand_reporting(dir.path(), &Pattern::new("**/*.msh").unwrap()).unwrap();
+        assert_eq!(found, ["good.msh"]);
+        assert_eq!(not_utf8.len(), 1, "{not_utf8:?}");
+        assert!(not_utf8[0].ends_with("caf\u{FFFD}.msh"), "{not_utf8:?}");
     }
 }

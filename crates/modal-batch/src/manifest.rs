@@ -26,7 +26,7 @@ use modal_fem::{Material, MaterialOverrides};
 use modal_precompute::{AccuracyTarget, MeshSource, Request, SurfaceMeshing};
 use serde::Deserialize;
 
-use crate::glob::{expand, Pattern};
+use crate::glob::{expand_reporting, Pattern};
 use crate::BatchError;
 
 /// Per-asset options; `None` inherits (asset > glob > `[defaults]` > CLI defaults).
@@ -287,7 +287,13 @@ impl Manifest {
                 return Err(self.error(format!("{table} cannot set {}", misplaced.join(", "))));
             }
             let pattern = Pattern::new(text).map_err(|m| self.error(format!("{table}: {m}")))?;
-            let matches = expand(&self.base, &pattern)?;
+            let (matches, not_utf8) = expand_reporting(&self.base, &pattern)?;
+            if let Some(first) = not_utf8.first() {
+                warnings.push(format!(
+                    "{table}: {} file name(s) are not UTF-8 and are left out (e.g. {first}): rename them",
+                    not_utf8.len()
+                ));
+            }
             if matches.is_empty() {
                 warnings.push(format!("{table} matches no file under {}", self.base.display()));
             }
