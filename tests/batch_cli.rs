@@ -442,6 +442,11 @@ fn manifest_and_merge_mistakes_are_one_clear_line() {
     let count_only = [("MODAL_SHARD_COUNT", "8")];
     modal(d, &["precompute-batch", "library.toml", "--out", "all"], &count_only)
         .fails_with("needs a shard index");
+    // A cache "directory" that is a file is one error, not a damaged entry per asset.
+    std::fs::write(d.join("not-a-dir"), b"").unwrap();
+    let args = ["precompute-batch", "library.toml", "--out", "filecache", "--cache-dir", "not-a-dir"];
+    modal(d, &args, &[]).fails_with("not a directory");
+    assert!(!d.join("filecache").exists());
     // The memory guard's variable applies to a batch as to precompute.
     let args = ["precompute-batch", "library.toml", "--out", "tight", "--cache-dir", "c2"];
     modal(d, &args, &[("MODAL_MEMORY_LIMIT_GB", "banana")]).fails_with("MODAL_MEMORY_LIMIT_GB");

@@ -92,10 +92,11 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
         ShardEnv::Slurm => format!("shard {shard} (Slurm array): "),
         ShardEnv::Kubernetes => format!("shard {shard} (JOB_COMPLETION_INDEX): "),
     };
+    let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let options = BatchOptions {
         out_dir: args.out.clone(),
-        cache: open_cache(args.cache_dir.as_deref(), args.no_cache),
+        cache,
         jobs: args.jobs,
         force: args.force,
         threads: args.threads,

@@ -66,13 +66,22 @@ pub fn memory_limit_from_env() -> Result<Option<u64>> {
     }
 }
 
-/// The cache the flags ask for (none with `--no-cache`).
-pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Option<BankCache> {
+/// The cache the flags ask for (none with `--no-cache`). A path that exists
+/// and is not a directory is refused at once: every asset of a batch would
+/// otherwise report it as "a damaged cache entry".
+pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Result<Option<BankCache>> {
     if disabled {
-        return None;
+        return Ok(None);
     }
-    let dir = dir.map(Path::to_path_buf).or_else(|| BankCache::default_dir().ok())?;
-    Some(BankCache::new(dir))
+    let Some(dir) = dir.map(Path::to_path_buf).or_else(|| BankCache::default_dir().ok()) else {
+        return Ok(None);
+    };
+    anyhow::ensure!(
+        !dir.exists() || dir.is_dir(),
+        "the cache directory {} is not a directory (--cache-dir or MODAL_CACHE_DIR)",
+        dir.display()
+    );
+    Ok(Some(BankCache::new(dir)))
 }
 
 pub fn run(args: PrecomputeArgs) -> Result<()> {
@@ -100,7 +109,7 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
             "--transfer-max-freq must be a positive frequency in Hz, got {f}"
         );
     }
-    let cache = open_cache(args.cache_dir.as_deref(), args.no_cache);
+    let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
     let spinner = Spinner::new("starting");
     // Warnings about the input are said when the mesh is read, once each, not after the solve.
     let mut said = std::collections::HashSet::new();

@@ -438,7 +438,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let spinner = Spinner::new("preparing the scene");
     let mut provider = PipelineProvider {
-        cache: open_cache(args.cache_dir.as_deref(), false),
+        cache: open_cache(args.cache_dir.as_deref(), false)?,
         spinner: &spinner,
         threads: args.threads,
         warnings: Vec::new(),
