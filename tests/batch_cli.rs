@@ -433,6 +433,13 @@ fn manifest_and_merge_mistakes_are_one_clear_line() {
     let partial = modal(d, &["catalogue", "merge", "out", "-o", "all.json", "--partial", "--json"], &[]).ok();
     assert_eq!(partial.json()["complete"], false);
     assert_eq!(load(&d.join("all.json"))["complete"], false);
+    // Shards of two runs (another material here; another file list on a node that
+    // saw fewer files) are not one library: their merge is refused.
+    let glass = std::fs::read_to_string(d.join("library.toml")).unwrap().replace("steel", "glass");
+    std::fs::write(d.join("glass.toml"), glass).unwrap();
+    let args = ["precompute-batch", "glass.toml", "--out", "out", "--shard", "1/2", "--cache-dir", "c"];
+    modal(d, &args, &[]).ok();
+    modal(d, &["catalogue", "merge", "out", "-o", "mixed.json"], &[]).fails_with("another library");
     // A library that resolves to nothing (a mount missing on this node) is an error,
     // not a complete empty catalogue on every shard.
     std::fs::write(d.join("nothing.toml"), "[[globs]]\npattern = \"absent/*.obj\"\nmaterial = \"steel\"\n")

@@ -82,6 +82,7 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     if all.is_empty() {
         bail!("{}: the manifest resolves to no asset", args.manifest.display());
     }
+    let library = modal_batch::Library::of(&all);
     let mut assets: Vec<_> = all.into_iter().filter(|a| shard.owns(&a.bank)).collect();
     if memory_limit.is_some() {
         assets.iter_mut().for_each(|a| a.request.memory_limit_bytes = memory_limit);
@@ -97,6 +98,7 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     let options = BatchOptions {
         out_dir: args.out.clone(),
         cache,
+        library: Some(library),
         jobs: args.jobs,
         force: args.force,
         threads: args.threads,

@@ -90,6 +90,39 @@ pub struct ShardInfo {
     pub count: usize,
 }
 
+/// The library a catalogue is part of: every asset its manifest resolved
+/// to, on every shard. Shards of one run agree on it; shards of two runs
+/// (another manifest, other options, a node that saw fewer files) do not,
+/// and a merge of them is refused or found short.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Library {
+    /// SHA-256 (hex) of every asset's path, bank and resolved options, in
+    /// bank order, with the source file named by its manifest path (so the
+    /// manifest's location on a node does not matter).
+    pub fingerprint: String,
+    /// Number of assets (all shards).
+    pub assets: usize,
+}
+
+impl Library {
+    /// The library of `assets` (all of the manifest's, before sharding).
+    pub fn of(assets: &[crate::Asset]) -> Library {
+        use sha2::{Digest, Sha256};
+        let mut sorted: Vec<&crate::Asset> = assets.iter().collect();
+        sorted.sort_by(|a, b| a.bank.cmp(&b.bank));
+        let mut h = Sha256::new();
+        h.update(b"modal-batch-library-v1");
+        for asset in sorted {
+            let mut request = asset.request.clone();
+            request.source = modal_precompute::MeshSource::File(asset.path.clone().into());
+            let line = format!("{}\0{}\0{request:?}\0{:?}\n", asset.path, asset.bank, asset.transfer_max_hz);
+            h.update(line.as_bytes());
+        }
+        let fingerprint = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+        Library { fingerprint, assets: assets.len() }
+    }
+}
+
 /// A batch's catalogue.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Catalogue {
@@ -104,6 +137,10 @@ pub struct Catalogue {
     /// The shard this catalogue is from; `null` for an unsharded run or a merge.
     #[serde(default)]
     pub shard: Option<ShardInfo>,
+    /// The whole library the run's manifest resolved to (`null` in
+    /// catalogues written before it was recorded).
+    #[serde(default)]
+    pub library: Option<Library>,
 }
 
 impl Catalogue {
@@ -125,6 +162,7 @@ impl Catalogue {
             complete: pending.is_empty(),
             pending,
             shard: (!shard.is_whole()).then_some(ShardInfo { index: shard.index, count: shard.count }),
+            library: None,
         }
     }
 
@@ -183,10 +221,12 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
     let mut pending = Vec::new();
     let mut complete = true;
     let mut shards = ShardCoverage::default();
+    let mut library = LibraryCheck::default();
     for input in inputs {
         for file in catalogue_files(input)? {
             let catalogue = Catalogue::load(&file)?;
             shards.add(catalogue.shard, &file)?;
+            library.add(catalogue.library.as_ref(), &file)?;
             let dir = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
             complete &= catalogue.complete;
             pending.extend(catalogue.pending);
@@ -223,8 +263,57 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
     pending.sort();
     pending.dedup();
     let mut merged = Catalogue::new(entries, pending, Shard::WHOLE);
+    merged.library = library.common();
+    if let Some(lib) = &merged.library {
+        // Entries are one per asset once repeats are dropped (above).
+        let listed = merged.assets.len() + merged.pending.len();
+        if listed < lib.assets {
+            report.missing.push(format!("{} of the library's {} assets", lib.assets - listed, lib.assets));
+        }
+    }
     merged.complete = complete && merged.pending.is_empty() && report.missing.is_empty();
     Ok((merged, report))
+}
+
+/// The library the merged catalogues agree on.
+#[derive(Default)]
+struct LibraryCheck {
+    /// The first library seen and its file.
+    first: Option<(Library, PathBuf)>,
+    /// A catalogue without one was read (written before it was recorded).
+    unknown: bool,
+}
+
+impl LibraryCheck {
+    /// Records the library of the catalogue `file`; two different ones are an error.
+    fn add(&mut self, library: Option<&Library>, file: &Path) -> Result<(), BatchError> {
+        let Some(library) = library else {
+            self.unknown = true;
+            return Ok(());
+        };
+        match &self.first {
+            Some((first, first_file)) if first != library => Err(BatchError::Catalogue {
+                path: file.display().to_string(),
+                message: format!(
+                    "is from another library than {} ({} against {} assets, or other files or \
+                     options): merge the catalogues of one run",
+                    first_file.display(),
+                    library.assets,
+                    first.assets
+                ),
+            }),
+            Some(_) => Ok(()),
+            None => {
+                self.first = Some((library.clone(), file.to_path_buf()));
+                Ok(())
+            }
+        }
+    }
+
+    /// The library every catalogue named (none when one named none).
+    fn common(self) -> Option<Library> {
+        self.first.filter(|_| !self.unknown).map(|(library, _)| library)
+    }
 }
 
 /// Which shards the merged catalogues are from.
@@ -421,6 +510,38 @@ mod tests {
         Catalogue::new(vec![], vec![], other).save(&other_file).unwrap();
         let err = merge(&[file(1), other_file], dir.path()).unwrap_err().to_string();
         assert!(err.contains("of 5") && err.contains("of 3 shards"), "{err}");
+    }
+
+    #[test]
+    fn shards_of_one_library_merge_and_a_short_or_foreign_one_is_caught() {
+        let dir = tempfile::tempdir().unwrap();
+        let library = |fingerprint: &str, assets| Some(Library { fingerprint: fingerprint.into(), assets });
+        let save = |name: &str, shard: Shard, paths: &[&str], lib: Option<Library>| {
+            let entries = paths.iter().map(|p| entry(p, "ok", 1.0)).collect();
+            let catalogue = Catalogue { library: lib, ..Catalogue::new(entries, vec![], shard) };
+            let path = dir.path().join(name);
+            catalogue.save(&path).unwrap();
+            path
+        };
+        let (a, b) = (Shard::new(0, 2).unwrap(), Shard::new(1, 2).unwrap());
+        let first = save("a.json", a, &["a.obj", "b.obj"], library("f", 4));
+        let second = save("b.json", b, &["c.obj", "d.obj"], library("f", 4));
+        let (merged, report) = merge(&[first.clone(), second], dir.path()).unwrap();
+        assert!(merged.complete && report.missing.is_empty());
+        assert_eq!(merged.library, library("f", 4));
+        // The second node saw one file fewer: its library differs.
+        let short = save("c.json", b, &["c.obj"], library("g", 3));
+        let err = merge(&[first.clone(), short], dir.path()).unwrap_err().to_string();
+        assert!(err.contains("another library"), "{err}");
+        // Same library, an asset not in any catalogue: incomplete.
+        let lost = save("d.json", b, &["c.obj"], library("f", 4));
+        let (merged, report) = merge(&[first.clone(), lost], dir.path()).unwrap();
+        assert!(!merged.complete);
+        assert_eq!(report.missing, ["1 of the library's 4 assets"]);
+        // A catalogue from before libraries were recorded: merged, not checked.
+        let old = save("e.json", b, &["c.obj"], None);
+        let (merged, _) = merge(&[first, old], dir.path()).unwrap();
+        assert!(merged.complete && merged.library.is_none());
     }
 
     #[test]

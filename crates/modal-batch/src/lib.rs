@@ -30,7 +30,7 @@ mod manifest;
 mod run;
 mod shard;
 
-pub use catalogue::{merge, Catalogue, CatalogueEntry, MergeReport, ShardInfo, CATALOGUE_FILE};
+pub use catalogue::{merge, Catalogue, CatalogueEntry, Library, MergeReport, ShardInfo, CATALOGUE_FILE};
 pub use glob::{expand as expand_glob, Pattern};
 pub use manifest::{Accuracy, Asset, Manifest, Options};
 pub use run::{run_asset, run_batch, BatchOptions, Event, SNAPSHOT_INTERVAL};

@@ -51,6 +51,9 @@ pub struct BatchOptions {
     pub threads: Option<usize>,
     /// The shard being run (names the catalogue file).
     pub shard: Shard,
+    /// The whole library (all shards), recorded in the catalogue so a merge
+    /// can tell the shards of one run from those of another.
+    pub library: Option<crate::Library>,
 }
 
 /// Progress of a batch, for the CLI's display.
@@ -81,7 +84,11 @@ pub fn run_batch(
 ) -> Result<Catalogue, BatchError> {
     let path = options.out_dir.join(Catalogue::file_name(options.shard));
     let pending: Vec<String> = assets.iter().map(|a| a.path.clone()).collect();
-    Catalogue::new(Vec::new(), pending.clone(), options.shard).save(&path)?;
+    let catalogue_of = |done: Vec<CatalogueEntry>, pending: Vec<String>| Catalogue {
+        library: options.library.clone(),
+        ..Catalogue::new(done, pending, options.shard)
+    };
+    catalogue_of(Vec::new(), pending.clone()).save(&path)?;
     struct State {
         done: Vec<CatalogueEntry>,
         pending: Vec<String>,
@@ -102,7 +109,7 @@ pub fn run_batch(
                 s.pending.remove(at);
             }
             if s.saved.elapsed() >= SNAPSHOT_INTERVAL {
-                let snapshot = Catalogue::new(s.done.clone(), s.pending.clone(), options.shard);
+                let snapshot = catalogue_of(s.done.clone(), s.pending.clone());
                 if let Err(e) = snapshot.save(&path) {
                     s.write_error.get_or_insert(e);
                 }
@@ -122,7 +129,7 @@ pub fn run_batch(
     if let Some(e) = s.write_error {
         return Err(e);
     }
-    let catalogue = Catalogue::new(s.done, s.pending, options.shard);
+    let catalogue = catalogue_of(s.done, s.pending);
     catalogue.save(&path)?;
     Ok(catalogue)
 }
