@@ -467,30 +467,10 @@ fn a_thread_count_that_cannot_help_is_refused_before_any_work() {
 /// `dent` moves the top of one corner down (1: a plain box).
 fn gltf_box_with_external_buffer(dir: &std::path::Path, dent: f32) {
     let (x, y, z) = (0.1f32, 0.05f32, 0.03f32);
-    let v = [
-        [0., 0., 0.],
-        [x, 0., 0.],
-        [0., y, 0.],
-        [x, y, 0.],
-        [0., 0., z],
-        [x, 0., z],
-        [0., y, z],
-        [x, y, z * dent],
-    ];
-    let f: [[u16; 3]; 12] = [
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
+    let cuboid = modal_tetra::shapes::cuboid(f64::from(x), f64::from(y), f64::from(z));
+    let mut v: Vec<[f32; 3]> = cuboid.vertices.iter().map(|p| p.map(|c| c as f32)).collect();
+    v[7][2] *= dent;
+    let f: Vec<[u16; 3]> = cuboid.triangles.iter().map(|t| t.map(|i| i as u16)).collect();
     let mut bin: Vec<u8> = v.iter().flatten().flat_map(|c: &f32| c.to_le_bytes()).collect();
     let vertex_bytes = bin.len();
     bin.extend(f.iter().flatten().flat_map(|i| i.to_le_bytes()));
