@@ -451,16 +451,24 @@ fn surface_options_on_a_tet_mesh_are_named_not_dropped() {
 }
 
 #[test]
-fn a_thread_count_that_cannot_help_is_refused_before_any_work() {
+fn absurd_thread_and_mode_counts_are_refused_before_any_work() {
     // 100 000 threads stalled for over a minute before the solve; 0 was taken silently.
     let dir = temp_dir();
     let bar = example("bar_p1.msh");
+    let args = ["precompute", bar.to_str().unwrap(), "-o", "b.bank", "--material", "steel", "--no-cache"];
     for n in ["0", "100000"] {
-        let args =
-            ["precompute", bar.to_str().unwrap(), "-o", "b.bank", "--material", "steel", "--threads", n];
-        modal(dir.path(), &args).fails_with("--threads must be between 1 and 1024");
-        assert!(!dir.path().join("b.bank").exists());
+        modal(dir.path(), &[&args[..], &["--threads", n]].concat())
+            .fails_with("--threads must be between 1 and 1024");
     }
+    // 10¹¹ modes overflowed the memory estimate into a solve, or blamed the mesh.
+    for n in ["0", "100000000000", "18446744073709551615"] {
+        modal(dir.path(), &[&args[..], &["--modes", n]].concat())
+            .fails_with("--modes must be between 1 and 100000");
+    }
+    // Within the range, a search space too large for the memory is said to be the modes'.
+    let many = [&args[..], &["--modes", "50000"]].concat();
+    modal_within_memory(dir.path(), &many, "1").fails_with("ask for fewer modes");
+    assert!(!dir.path().join("b.bank").exists());
 }
 
 /// A 10 × 5 × 3 cm box as a `.gltf` whose geometry is in `box.bin` next to it;

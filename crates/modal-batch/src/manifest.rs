@@ -387,8 +387,12 @@ fn check_request(r: &Request, o: &Options) -> Result<(), String> {
     if !matches!(r.order, 1 | 2) {
         return Err(format!("`order` must be 1 or 2, got {}", r.order));
     }
-    if r.max_modes == 0 {
-        return Err("`modes` must be at least 1".into());
+    if !(1..=modal_precompute::MAX_MODES).contains(&r.max_modes) {
+        return Err(format!(
+            "`modes` must be between 1 and {}, got {}",
+            modal_precompute::MAX_MODES,
+            r.max_modes
+        ));
     }
     if !(r.min_freq_hz.is_finite() && r.min_freq_hz >= 0.0) {
         return Err(format!("`min_freq` must be a non-negative number, got {}", r.min_freq_hz));

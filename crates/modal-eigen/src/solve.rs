@@ -145,20 +145,26 @@ fn solve_validated(
     progress(Progress::PhaseEnd { phase: Phase::Symbolic, seconds: stats.symbolic_s });
 
     let block = opts.block_size.min(n.saturating_sub(n_rigid).max(1));
-    let nev_guess = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
+    let nev_guess = opts.max_modes.saturating_add(MAX_BELOW_FOR_LOW_SHIFT);
     let ncv_guess = basis_size(nev_guess, block);
+    let search_space = vector_bytes(n, nev_guess, ncv_guess, block);
     stats.memory_estimate_bytes =
-        factor.memory_estimate() + factor.pattern_bytes() + vector_bytes(n, nev_guess, ncv_guess, block);
+        factor.memory_estimate().saturating_add(factor.pattern_bytes()).saturating_add(search_space);
     let limit = opts.memory_limit_bytes.or_else(default_memory_limit);
     if let Some(limit) = limit {
         if stats.memory_estimate_bytes > limit {
-            return Err(EigenError::MemoryLimit { estimated: stats.memory_estimate_bytes, limit });
+            return Err(EigenError::MemoryLimit {
+                estimated: stats.memory_estimate_bytes,
+                limit,
+                search_space,
+                modes: opts.max_modes,
+            });
         }
     }
     let overlap = opts.overlap_check
-        && limit.is_none_or(|l| stats.memory_estimate_bytes + factor.memory_estimate() <= l);
+        && limit.is_none_or(|l| stats.memory_estimate_bytes.saturating_add(factor.memory_estimate()) <= l);
     if overlap {
-        stats.memory_estimate_bytes += factor.memory_estimate();
+        stats.memory_estimate_bytes = stats.memory_estimate_bytes.saturating_add(factor.memory_estimate());
     }
 
     // Lower inertia count and shift choice.
@@ -177,7 +183,7 @@ fn solve_validated(
     let mut elastic_below = nu_lo.saturating_sub(n_rigid);
     let low_shift = !count_below || elastic_below <= MAX_BELOW_FOR_LOW_SHIFT;
     let below_known = if low_shift { elastic_below } else { 0 };
-    let mut wanted = below_known + opts.max_modes;
+    let mut wanted = below_known.saturating_add(opts.max_modes);
     // Memory the first search and the early inertia count will write, made on the second
     // core while the Cholesky factorization keeps the first one busy (fresh pages cost ≈ 4 µs
     // each to fault in on the machines measured; see `factor::touched`).
@@ -386,7 +392,7 @@ fn stall_hint(e: EigenError, below: Option<usize>, min_freq_hz: f64) -> EigenErr
 /// most factors.
 pub fn vector_bytes_per_dof(opts: &EigenOptions) -> u64 {
     let block = opts.block_size.max(1);
-    let nev = opts.max_modes + MAX_BELOW_FOR_LOW_SHIFT;
+    let nev = opts.max_modes.saturating_add(MAX_BELOW_FOR_LOW_SHIFT);
     vector_bytes(1, nev, basis_size(nev, block), block)
 }
 
@@ -396,7 +402,7 @@ pub fn vector_bytes_per_dof(opts: &EigenOptions) -> u64 {
 /// 50 modes: 29 instead of 33) and 1–2 restarts instead of 7; beyond that the extra columns are
 /// capped so that orthogonalization and memory stay linear in nev.
 fn basis_size(nev: usize, block: usize) -> usize {
-    nev + nev.max((2 * nev).min(EXTRA_BASIS)).max(3 * block)
+    nev.saturating_add(nev.max(nev.saturating_mul(2).min(EXTRA_BASIS)).max(3 * block))
 }
 
 /// (nev, ncv) of a search for `wanted` pairs with `free` dimensions left after deflation.
@@ -409,7 +415,10 @@ fn search_size(wanted: usize, free: usize, block: usize) -> (usize, usize) {
 /// block each), a few blocks of work space, and the residual check's Ritz vectors with their
 /// K- and M-images and rotated copies (six sets of up to `nev` vectors).
 fn vector_bytes(n: usize, nev: usize, ncv: usize, block: usize) -> u64 {
-    (n * (2 * (ncv + block) + 4 * block + 6 * nev) * 8) as u64
+    // Saturating: an absurd mode count must read as "too much memory", not wrap.
+    let columns = (ncv as u64).saturating_add(block as u64).saturating_mul(2);
+    let columns = columns.saturating_add(4 * block as u64).saturating_add((nev as u64).saturating_mul(6));
+    (n as u64).saturating_mul(columns).saturating_mul(8)
 }
 
 /// Re-establishes the operator factor after an inertia factorization replaced it.
@@ -662,4 +671,28 @@ fn validate(
         return bad("block_size", "must be in 1..=64");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_absurd_mode_count_saturates_the_memory_estimate_instead_of_wrapping() {
+        // Wrapped, `usize::MAX` modes read as a few bytes and the solve went ahead.
+        let nev = usize::MAX.saturating_add(MAX_BELOW_FOR_LOW_SHIFT);
+        assert_eq!(vector_bytes(4149, nev, basis_size(nev, 8), 8), u64::MAX);
+        let message = EigenError::MemoryLimit {
+            estimated: u64::MAX,
+            limit: 1 << 30,
+            search_space: u64::MAX,
+            modes: nev,
+        }
+        .to_string();
+        assert!(message.contains("ask for fewer modes"), "{message}");
+        let mesh_bound =
+            EigenError::MemoryLimit { estimated: 4 << 30, limit: 1 << 30, search_space: 1 << 20, modes: 64 }
+                .to_string();
+        assert!(mesh_bound.contains("coarser mesh"), "{mesh_bound}");
+    }
 }

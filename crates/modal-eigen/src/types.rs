@@ -267,12 +267,17 @@ pub enum EigenError {
         shift: f64,
     },
     /// Estimated memory above the limit.
-    #[error("the factorization needs about {} MB but the limit is {} MB; use --order 1 or a coarser mesh", estimated / 1_000_000, limit / 1_000_000)]
+    #[error("{}", memory_limit_message(*estimated, *limit, *search_space, *modes))]
     MemoryLimit {
         /// Estimated bytes.
         estimated: u64,
         /// Limit in bytes.
         limit: u64,
+        /// Of `estimated`, the search space's vectors [bytes], which grow
+        /// with the number of modes asked for (the rest is the factor).
+        search_space: u64,
+        /// Modes asked for.
+        modes: usize,
     },
     /// Iteration limit reached before all wanted modes converged.
     #[error("eigensolver did not converge: {converged} of {wanted} wanted modes converged")]
@@ -306,4 +311,25 @@ pub enum EigenError {
     /// faer or METIS failed (out of memory, index overflow).
     #[error("sparse factorization failed: {0}")]
     Factorization(String),
+}
+
+/// What [`EigenError::MemoryLimit`] says: the remedy for what dominates the
+/// estimate (a mesh's factor, or the vectors of too many modes).
+fn memory_limit_message(estimated: u64, limit: u64, search_space: u64, modes: usize) -> String {
+    let mb = |bytes: u64| bytes / 1_000_000;
+    if search_space > estimated / 2 {
+        format!(
+            "the search space for {modes} modes needs about {} MB (with the factorization {} MB) but the \
+             limit is {} MB; ask for fewer modes",
+            mb(search_space),
+            mb(estimated),
+            mb(limit)
+        )
+    } else {
+        format!(
+            "the factorization needs about {} MB but the limit is {} MB; use --order 1 or a coarser mesh",
+            mb(estimated),
+            mb(limit)
+        )
+    }
 }

@@ -191,7 +191,7 @@ fn memory_guard_refuses_before_factoring_with_a_clear_error() {
     let opts = EigenOptions { memory_limit_bytes: Some(1_000_000), ..Default::default() };
     let err = solve(&a.k, &a.m, Some(rigid.as_ref()), &opts, &mut |_| {}).unwrap_err();
     match &err {
-        modal_eigen::EigenError::MemoryLimit { estimated, limit } => {
+        modal_eigen::EigenError::MemoryLimit { estimated, limit, .. } => {
             assert_eq!(*limit, 1_000_000);
             assert!(*estimated > *limit, "{estimated}");
         }

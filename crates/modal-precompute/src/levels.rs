@@ -214,7 +214,7 @@ fn widened(request: &Request) -> Request {
     wide.surface = request.surface_meshing();
     wide.min_freq_hz = request.min_freq_hz / BAND_MARGIN;
     wide.max_freq_hz = request.max_freq_hz * BAND_MARGIN;
-    wide.max_modes = request.max_modes + (request.max_modes / 4).max(6);
+    wide.max_modes = request.max_modes.saturating_add((request.max_modes / 4).max(6));
     wide
 }
 

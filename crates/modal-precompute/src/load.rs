@@ -127,12 +127,14 @@ impl TetBudget {
 
     fn refusal(&self, estimated: u64) -> PrecomputeError {
         let needed_bytes = self.min_bytes(estimated);
+        let vectors = 3 * self.vector_bytes_per_dof * estimated;
         PrecomputeError::Memory {
             message: format!(
                 "the surface would be meshed into about {estimated} tets, whose stiffness, mass, factor and the \
-                 eigensolver's vectors need at least {:.1} GB, above the memory limit of {:.1} GB; use a coarser mesh (a larger --cell) or --order 1",
+                 eigensolver's vectors need at least {:.1} GB, above the memory limit of {:.1} GB; {}",
                 needed_bytes as f64 / 1e9,
-                self.limit_bytes as f64 / 1e9
+                self.limit_bytes as f64 / 1e9,
+                crate::pipeline::memory_remedy(vectors, needed_bytes, "a larger --cell")
             ),
             needed_bytes,
             limit_bytes: self.limit_bytes,
