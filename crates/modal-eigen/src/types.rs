@@ -314,10 +314,12 @@ pub enum EigenError {
 }
 
 /// What [`EigenError::MemoryLimit`] says: the remedy for what dominates the
-/// estimate (a mesh's factor, or the vectors of too many modes).
+/// estimate (a mesh's factor, or the vectors of too many modes when the
+/// factor alone would fit).
 fn memory_limit_message(estimated: u64, limit: u64, search_space: u64, modes: usize) -> String {
     let mb = |bytes: u64| bytes / 1_000_000;
-    if search_space > estimated / 2 {
+    // Fewer modes help only when the rest (the factor) would fit.
+    if search_space > estimated / 2 && estimated - search_space.min(estimated) <= limit {
         format!(
             "the search space for {modes} modes needs about {} MB (with the factorization {} MB) but the \
              limit is {} MB; ask for fewer modes",

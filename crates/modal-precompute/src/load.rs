@@ -134,7 +134,7 @@ impl TetBudget {
                  eigensolver's vectors need at least {:.1} GB, above the memory limit of {:.1} GB; {}",
                 needed_bytes as f64 / 1e9,
                 self.limit_bytes as f64 / 1e9,
-                crate::pipeline::memory_remedy(vectors, needed_bytes, "a larger --cell")
+                crate::pipeline::memory_remedy(vectors, needed_bytes, self.limit_bytes, "a larger --cell")
             ),
             needed_bytes,
             limit_bytes: self.limit_bytes,

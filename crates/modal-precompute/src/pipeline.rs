@@ -307,7 +307,7 @@ fn refuse_beyond_memory(
             factor_bytes as f64 / 1e9,
             vector_bytes as f64 / 1e9,
             limit as f64 / 1e9,
-            memory_remedy(vector_bytes, needed_bytes, "a larger element size or --cell")
+            memory_remedy(vector_bytes, needed_bytes, limit, "a larger element size or --cell")
         ),
         needed_bytes,
         limit_bytes: limit,
@@ -401,12 +401,12 @@ fn bank_warnings(request: &Request, bank: &ModeBank) -> Vec<String> {
     residual_floor_warning(bank).into_iter().chain(silent).collect()
 }
 
-/// What to change when a solve needs `needed` bytes, `vectors` of them the
-/// eigensolver's vectors (which grow with the modes asked for, the rest
-/// with the mesh): fewer modes when they dominate, else a coarser mesh
-/// (`coarser` says how).
-pub(crate) fn memory_remedy(vectors: u64, needed: u64, coarser: &str) -> String {
-    if vectors > needed / 2 {
+/// What to change when a solve needs `needed` bytes of `limit`, `vectors`
+/// of them the eigensolver's vectors (which grow with the modes asked for,
+/// the rest with the mesh): fewer modes when they dominate and the rest
+/// would fit, else a coarser mesh (`coarser` says how).
+pub(crate) fn memory_remedy(vectors: u64, needed: u64, limit: u64, coarser: &str) -> String {
+    if vectors > needed / 2 && needed - vectors.min(needed) <= limit {
         "ask for fewer modes (--modes)".to_string()
     } else {
         format!("use a coarser mesh ({coarser}) or --order 1")
