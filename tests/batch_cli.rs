@@ -464,6 +464,27 @@ fn manifest_and_merge_mistakes_are_one_clear_line() {
     for entry in entries(&tight) {
         assert!(entry["status"].as_str().unwrap().contains("memory"), "{entry}");
     }
+    // The --jobs solves that run at once share the limit: a limit one solve fits
+    // in alone is too small for two at a time (measured: the two boxes of this
+    // library need between 0.5 and 1 MB each; 1 MB solves them one by one, and
+    // refuses them two by two, 0.5 MB each).
+    let shared = |jobs: &str| {
+        let args = [
+            "precompute-batch",
+            "library.toml",
+            "--out",
+            "shared",
+            "--no-cache",
+            "--force",
+            "-j",
+            jobs,
+            "--json",
+        ];
+        let run = modal(d, &args, &[("MODAL_MEMORY_LIMIT_GB", "0.001")]);
+        run.json()["failed"].as_u64().unwrap()
+    };
+    assert_eq!(shared("1"), 0);
+    assert_eq!(shared("2"), 2, "both boxes refused at 0.5 MB each");
 }
 
 /// Banks of surface meshes carry the per-mode error estimate like `modal precompute`'s

@@ -71,9 +71,17 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
     }
     let (shard, from) =
         Shard::select(args.shard.as_deref(), args.shard_count, |name| std::env::var(name).ok())?;
-    // The memory guard of `modal precompute`: in a pod or a Slurm job the
-    // machine's free memory is not the job's limit.
-    let memory_limit = memory_limit_from_env()?;
+    // The memory guard of `modal precompute` (in a pod or a Slurm job the
+    // machine's free memory is not the job's limit), shared by the --jobs
+    // solves that run at once: each alone within the whole would not keep
+    // them together within it.
+    let jobs = args.jobs as u64;
+    let memory_limit = match memory_limit_from_env()? {
+        Some(bytes) => Some(bytes / jobs),
+        // One job: the solver's own default, judged at each solve.
+        None if jobs == 1 => None,
+        None => modal_eigen::default_memory_limit().map(|bytes| bytes / jobs),
+    };
     let manifest = Manifest::load(&args.manifest)?;
     let (all, warnings) = manifest.resolve()?;
     warnings.iter().for_each(|w| warn(w));
