@@ -143,6 +143,17 @@ impl Shard {
                 BatchError::Shard(format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}"))
             })?;
             let step = number("SLURM_ARRAY_TASK_STEP")?.unwrap_or(1).max(1);
+            // A range's last id is MIN + (COUNT − 1)·STEP; a list's (3,5,7: COUNT 3,
+            // STEP unset) is not, and no task of it can tell its shard.
+            let range_end =
+                n.checked_sub(1).and_then(|k| k.checked_mul(step)).and_then(|k| k.checked_add(min));
+            if let Some(max) = number("SLURM_ARRAY_TASK_MAX")?.filter(|&max| Some(max) != range_end) {
+                return Err(BatchError::Shard(format!(
+                    "SLURM_ARRAY_TASK_MIN {min}, MAX {max} and COUNT {n} (STEP {step}) are not a range: an \
+                     array given as a list of indices has no shard mapping; use a range (--array=0-N or \
+                     0-N:S) or --shard I/N"
+                )));
+            }
             if offset % step != 0 {
                 return Err(BatchError::Shard(format!(
                     "SLURM_ARRAY_TASK_ID {id} is not SLURM_ARRAY_TASK_MIN {min} plus a multiple of \
@@ -271,6 +282,18 @@ mod tests {
             [("SLURM_ARRAY_TASK_ID", "7"), ("SLURM_ARRAY_TASK_MIN", "3"), ("SLURM_ARRAY_TASK_COUNT", "3")];
         let err = Shard::select(None, None, env(&list)).unwrap_err().to_string();
         assert!(err.contains("list of indices"), "{err}");
+        // With MAX (Slurm exports it), every task of the list is refused, id 5 too.
+        let list = [
+            ("SLURM_ARRAY_TASK_ID", "5"),
+            ("SLURM_ARRAY_TASK_MIN", "3"),
+            ("SLURM_ARRAY_TASK_MAX", "7"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ];
+        let err = Shard::select(None, None, env(&list)).unwrap_err().to_string();
+        assert!(err.contains("not a range"), "{err}");
+        let mut range = stepped("6").to_vec();
+        range.push(("SLURM_ARRAY_TASK_MAX", "14"));
+        assert_eq!(Shard::select(None, None, env(&range)).unwrap().0, Shard::new(3, 8).unwrap());
     }
 
     #[test]
