@@ -20,7 +20,7 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
                 let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
                 key = key.add_str("mesh_kind", &ext).add("mesh", &bytes);
             }
-            if is_gltf(path) {
+            if modal_tetra::SurfaceFormat::from_path(path) == Some(modal_tetra::SurfaceFormat::Gltf) {
                 // A .gltf's geometry lives in the files its buffers name (a .glb's
                 // own chunk is in the bytes above): a re-exported .bin is a new mesh.
                 for (i, bytes) in modal_tetra::gltf_uri_buffers(path)?.iter().enumerate() {
@@ -52,12 +52,6 @@ pub fn cache_key(request: &Request) -> Result<String, PrecomputeError> {
             .add_str("accuracy", &format!("{}:{}:{}", crate::levels::LEVELS_VERSION, a.target_pct, a.modes));
     }
     Ok(key.finish())
-}
-
-/// Whether `path` names a glTF file (`.gltf` or `.glb`, any case).
-fn is_gltf(path: &Path) -> bool {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    ext.eq_ignore_ascii_case("gltf") || ext.eq_ignore_ascii_case("glb")
 }
 
 /// The files whose bytes define a mesh: a TetGen mesh is two files.
