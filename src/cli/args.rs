@@ -358,7 +358,8 @@ pub struct StrikeArgs {
     /// Contact time τ [s] of the half-sine force.
     #[arg(long, value_name = "S", conflicts_with = "hertz")]
     pub contact_time: Option<f64>,
-    /// Hertz contact of a sphere of MASS_KG and RADIUS_M striking at 1 m/s.
+    /// Hertz contact of a sphere of MASS_KG and RADIUS_M of the bank's material, striking at the speed
+    /// --impulse / MASS_KG (the impulse it delivers when it stops; 1 m/s for a zero impulse).
     #[arg(long, value_name = "MASS_KG,RADIUS_M", value_parser = parse_pair, allow_hyphen_values = true)]
     pub hertz: Option<[f64; 2]>,
     /// Contact microphone position X,Y,Z [m]: output the normal surface velocity there [m/s, full scale 1]
@@ -373,7 +374,7 @@ pub struct StrikeArgs {
     /// Solve the radiation now when the bank has none stored (slow; see `modal radiation --store`).
     #[arg(long, conflicts_with = "mic")]
     pub solve_radiation: bool,
-    /// Duration [s] (default: until the sound decayed by 60 dB).
+    /// Duration [s], above 0 and at most 3600 (default: until the sound decayed by 60 dB).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Sample rate [Hz].

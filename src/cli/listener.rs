@@ -1,12 +1,20 @@
-//! What `strike` hears at a listener: per-mode pressure transfer gains.
+//! What `strike` hears at a listener: per-mode complex pressure transfer.
 //!
-//! Mode `i` moving with modal velocity `q̇_i(t)` radiates `p(x, t) ≈
-//! |T_i(x)| q̇_i(t)` at the listener, `T_i(x)` the complex pressure [Pa] for
-//! unit modal velocity amplitude (`modal radiation`). The synthesizer's
-//! per-mode gains are real, so each mode keeps its level and decay; the
-//! phase of `T_i` (a per-mode time offset of a fraction of a period, plus
-//! the common propagation delay `r/c`) is dropped. Samples are pressure
-//! divided by [`FULL_SCALE_PA`], the full scale of `render` at gain 1.
+//! Mode `i` vibrating with modal velocity `Re(V_i e^{−iωt})` radiates
+//! `Re(T_i(x) V_i e^{−iωt})` at the listener, `T_i(x)` the complex pressure
+//! [Pa] for unit modal velocity amplitude (`modal radiation`). In the
+//! synthesizer's convention (`e^{+iωt}`, [`modal_synth::modulation`]) that
+//! is the real gain `g_i = |T_i| / FULL_SCALE_PA` (level, decay and culling
+//! use it) times the unit factor `conj(T_i e^{−ik_i r₀}) / |T_i|`. The phase
+//! matters: symmetric bodies (a bowl, a bell, a sphere) have pairs of modes
+//! at one frequency whose transfers add or cancel at the listener depending
+//! on how the pair's shapes happen to be turned; with `|T_i|` alone the
+//! level of a rim strike on a glass bowl changed by 47 dB with the strike's
+//! angle. `e^{−ik_i r₀}` (`r₀` one distance for every mode, the listener's
+//! from the expansion centre) removes the common propagation delay `r₀/c`,
+//! so the file starts at the strike rather than `r₀/c` later, as `render`
+//! does before its own delay. Samples are pressure divided by
+//! [`FULL_SCALE_PA`], the full scale of `render` at gain 1.
 //!
 //! The transfer comes from, in order of preference:
 //! 1. the bank's stored radiation table (`modal radiation --store`); its
@@ -15,19 +23,19 @@
 //!    mass hears, as in `render`, the field at `r_f` in its direction
 //!    spread back by `r_f / max(r, r_min)` (`r_min` = `MIN_DISTANCE_M`; at
 //!    the centre itself, where no direction is defined, the
-//!    direction-averaged level);
+//!    direction-averaged level, with no phase);
 //! 2. a boundary-element solve now (`--solve-radiation`),
 //! 3. the level estimate `render` uses without radiation (a pulsating
 //!    sphere with the object's area and the mode's RMS normal velocity,
-//!    `ρ₀c (a/r) (ka/√(1+(ka)²)) v_i`), with a warning.
+//!    `ρ₀c (a/r) (ka/√(1+(ka)²)) v_i`, no phase), with a warning.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use modal_bank::ModeBank;
-use modal_radiation::{Air, RadiationOptions};
+use modal_radiation::{c64, Air, RadiationOptions};
 use modal_scene::{AIR_IMPEDANCE_PA_S_M, FULL_SCALE_PA, MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
-use modal_synth::SynthModel;
+use modal_synth::{SynthModel, C64};
 
 use super::output::warn;
 
@@ -82,21 +90,39 @@ pub enum TransferSource {
 pub struct ListenerGains {
     /// One gain per bank mode: `|T_i| / FULL_SCALE_PA`.
     pub gains: Vec<f64>,
+    /// One unit factor per bank mode, the transfer's phase (module doc);
+    /// `1` where no phase is known (the estimate).
+    pub phases: Vec<C64>,
     /// Where the transfer came from.
     pub source: TransferSource,
 }
 
-/// Gains for a listener at `x` (bank frame) of the bank stored at `path`.
-pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) -> Result<ListenerGains> {
+/// Gains for a listener at `x` (bank frame) of the bank stored at `path`,
+/// for the modes a render at `sample_rate_hz` plays (the others are never
+/// heard, so never solved).
+pub fn listener_gains(
+    path: &Path,
+    bank: &ModeBank,
+    x: [f64; 3],
+    solve: bool,
+    sample_rate_hz: f64,
+) -> Result<ListenerGains> {
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
     super::radiation::check_field_points(bank, &mesh, &[x]).context("--listener")?;
-    let audible = modal_radiation::modes::audible_modes(bank, f64::INFINITY);
+    let mut audible = modal_radiation::modes::audible_modes(bank, f64::INFINITY);
+    audible.retain(|&i| {
+        let (f, d, xi) = (bank.frequencies_hz[i], bank.decay_rates[i], bank.damping_ratios[i]);
+        modal_synth::classify_mode(f, d, xi, sample_rate_hz).is_ok()
+    });
     let table = stored_radiation(path)?;
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
-        let mut gains = vec![0.0; bank.mode_count()];
+        let mut heard = Heard::new(bank.mode_count());
         let mut missing = 0;
         let r = distance(x, table.centre_m);
+        // The field is taken at the fit sphere inside it (`held_pressure`),
+        // and has no phase at the centre itself.
+        let r_ref = if r > 0.0 { r.max(table.fit_radius_m) } else { 0.0 };
         if r < table.fit_radius_m {
             warn(&format!(
                 "the listener is {r:.3} m from the centre of mass, inside the {:.3} m radius the stored far field \
@@ -109,10 +135,10 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
             match table.mode(i) {
                 Some(entry) => {
                     let mp = modal_radiation::modes::stored_multipole(&table, entry);
-                    gains[i] = held_level(&mp, x) / FULL_SCALE_PA;
+                    heard.set(i, held_pressure(&mp, x), mp.wavenumber * r_ref);
                 }
                 None => {
-                    gains[i] = estimate[i];
+                    heard.gains[i] = estimate[i];
                     missing += 1;
                 }
             }
@@ -120,7 +146,7 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
         if missing > 0 {
             warn(&format!("{missing} audible mode(s) have no stored radiation: their level is estimated"));
         }
-        return Ok(ListenerGains { gains, source: TransferSource::Stored });
+        return Ok(heard.from(TransferSource::Stored));
     }
     if solve {
         let opts = RadiationOptions { air: Air::default(), ..RadiationOptions::default() };
@@ -129,18 +155,50 @@ pub fn listener_gains(path: &Path, bank: &ModeBank, x: [f64; 3], solve: bool) ->
             eprintln!("{p}")
         })?;
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
-        let mut gains = vec![0.0; bank.mode_count()];
+        let mut heard = Heard::new(bank.mode_count());
         for r in &results {
-            gains[r.mode] = r.pressure_at(x)?.norm() / FULL_SCALE_PA;
+            let r_ref = distance(x, r.multipole.centre);
+            heard.set(r.mode, r.pressure_at(x)?, r.multipole.wavenumber * r_ref);
         }
-        return Ok(ListenerGains { gains, source: TransferSource::Solved });
+        return Ok(heard.from(TransferSource::Solved));
     }
     warn(&format!(
         "{} has no radiation data: the listener level is a pulsating-sphere estimate \
          (run `modal radiation BANK --store OUT.bank`, or strike with --solve-radiation)",
         path.display()
     ));
-    Ok(ListenerGains { gains: estimate_gains(bank, x)?, source: TransferSource::Estimate })
+    let gains = estimate_gains(bank, x)?;
+    let phases = vec![C64::new(1.0, 0.0); gains.len()];
+    Ok(ListenerGains { gains, phases, source: TransferSource::Estimate })
+}
+
+/// Gains and phases being filled in, mode by mode.
+struct Heard {
+    gains: Vec<f64>,
+    phases: Vec<C64>,
+}
+
+impl Heard {
+    fn new(modes: usize) -> Heard {
+        Heard { gains: vec![0.0; modes], phases: vec![C64::new(1.0, 0.0); modes] }
+    }
+
+    /// Mode `i` heard through the transfer `t` [Pa per unit modal velocity]
+    /// whose common delay is the phase `kr₀` (module doc).
+    fn set(&mut self, i: usize, t: c64, k_r0: f64) {
+        let level = t.norm();
+        self.gains[i] = level / FULL_SCALE_PA;
+        if level > 0.0 && level.is_finite() {
+            let (s, c) = k_r0.sin_cos();
+            // conj(t e^{−ikr₀}) = conj(t) e^{ikr₀}.
+            let reduced = c64::new(t.re, -t.im) * c64::new(c, s) / level;
+            self.phases[i] = C64::new(reduced.re, reduced.im);
+        }
+    }
+
+    fn from(self, source: TransferSource) -> ListenerGains {
+        ListenerGains { gains: self.gains, phases: self.phases, source }
+    }
 }
 
 /// The radiation table stored in the bank file at `path` (`None` for banks
@@ -156,22 +214,22 @@ pub fn stored_radiation(path: &Path) -> Result<Option<modal_bank::RadiationTable
     Ok(table)
 }
 
-/// `|p|` [Pa] of the stored expansion `mp` heard at `x` (module doc):
-/// `|P(x)|` beyond the fit radius, the fit sphere's field spread back by
-/// `r_f / max(r, r_min)` inside it, the direction-averaged level at the
-/// centre.
-fn held_level(mp: &modal_radiation::Multipole, x: [f64; 3]) -> f64 {
+/// `p` [Pa] of the stored expansion `mp` heard at `x` (module doc): `P(x)`
+/// beyond the fit radius, the fit sphere's field spread back by
+/// `r_f / max(r, r_min)` inside it, the direction-averaged level (real) at
+/// the centre.
+fn held_pressure(mp: &modal_radiation::Multipole, x: [f64; 3]) -> c64 {
     let r = distance(x, mp.centre);
     if r >= mp.fit_radius {
-        return mp.pressure_at(x).norm();
+        return mp.pressure_at(x);
     }
     let spread = mp.fit_radius / r.max(MIN_DISTANCE_M);
     if r == 0.0 {
         // The far-field level at the fit radius, RMS over directions.
-        return mp.far_field_rms() / mp.fit_radius * spread;
+        return c64::new(mp.far_field_rms() / mp.fit_radius * spread, 0.0);
     }
     let on_sphere = [0, 1, 2].map(|q| mp.centre[q] + (x[q] - mp.centre[q]) * mp.fit_radius / r);
-    mp.pressure_at(on_sphere).norm() * spread
+    mp.pressure_at(on_sphere) * spread
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -230,11 +288,11 @@ mod tests {
     fn a_listener_inside_the_fit_radius_hears_the_fit_sphere_spread_back() {
         let c = [0.1, -0.2, 0.05];
         let mp = expansion(c);
-        let at = |dir: [f64; 3], r: f64| held_level(&mp, [0, 1, 2].map(|q| c[q] + dir[q] * r));
+        let at = |dir: [f64; 3], r: f64| held_pressure(&mp, [0, 1, 2].map(|q| c[q] + dir[q] * r)).norm();
         let dir = [0.6, 0.0, 0.8];
         // Beyond the fit radius: the expansion itself.
         let far = [0, 1, 2].map(|q| c[q] + dir[q] * 0.7);
-        assert_eq!(held_level(&mp, far), mp.pressure_at(far).norm());
+        assert_eq!(held_pressure(&mp, far), mp.pressure_at(far));
         // Continuous at the fit radius, then 1/r inwards, held below r_min.
         let on = at(dir, 0.3);
         assert!((at(dir, 0.3 * (1.0 - 1e-12)) - on).abs() < 1e-9 * on);
@@ -257,7 +315,7 @@ mod tests {
             })
             .sum::<f64>()
             / 400.0;
-        let centre = held_level(&mp, c);
+        let centre = held_pressure(&mp, c).norm();
         let want = mean.sqrt() / 0.3 * 0.3 / MIN_DISTANCE_M;
         assert!(centre.is_finite() && (centre - want).abs() < 0.01 * want, "{centre} vs {want}");
     }

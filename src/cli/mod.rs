@@ -63,6 +63,26 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// Checks, before any long work, that `path` can be written the way
+/// [`write_atomic`] (or a library's atomic writer) will write it: `path` is
+/// not a directory, and its directory exists and takes a new file (a probe
+/// file is created there and removed). So a solve of minutes never ends in
+/// "cannot write".
+pub fn check_writable(path: &Path) -> anyhow::Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    anyhow::ensure!(!path.is_dir(), "{} is a directory", path.display());
+    let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
+    anyhow::ensure!(dir.is_dir(), "directory {} does not exist", dir.display());
+    let probe = dir.join(format!(".{}.{}.probe", name.to_string_lossy(), std::process::id()));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|e| anyhow::anyhow!("cannot write in {}: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
 /// Writes a file atomically: `write` fills a temporary file next to `path`,
 /// which is then renamed over `path`. On any error the temporary file is
 /// removed, so a failed or interrupted command never leaves a partial output.

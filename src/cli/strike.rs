@@ -6,10 +6,11 @@
 use anyhow::{bail, ensure, Context, Result};
 use modal_bank::ModeBank;
 use modal_synth::{
-    contact, render_strikes, OutputGain, RenderLength, Strike, SynthModel, SynthOptions, WavFormat, WavGain,
-    DEFAULT_CONTACT_TIME_S,
+    contact, render_strikes_modulated, ConstantFactors, OutputGain, OutputModulation, RenderLength, Strike,
+    SynthModel, SynthOptions, WavFormat, WavGain, DEFAULT_CONTACT_TIME_S,
 };
 use serde::Serialize;
+use std::sync::Arc;
 
 use super::args::StrikeArgs;
 use super::bank_cmds::load_bank;
@@ -98,6 +99,16 @@ fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f
 }
 
 pub fn run(args: StrikeArgs) -> Result<()> {
+    // Everything a radiation solve could be wasted on is checked first.
+    modal_synth::check_sample_rate(args.rate as f64)?;
+    if let Some(d) = args.duration {
+        ensure!(
+            d.is_finite() && d > 0.0 && d <= modal_synth::MAX_DURATION_S,
+            "--duration must be above 0 s and at most {} s (got {d})",
+            modal_synth::MAX_DURATION_S
+        );
+    }
+    super::check_writable(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     let bank = load_bank(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
     let at_points = if args.at.is_empty() {
@@ -134,9 +145,10 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         });
     }
     // Output: the pressure at a listener (default), or a contact microphone.
-    let (gain, output) = match args.mic {
+    let (gain, phases, output) = match args.mic {
         Some(at) => (
             OutputGain::ContactMic { at: Some(at) },
+            None,
             OutputJson { kind: "contact_mic", listener_m: None, transfer: None },
         ),
         None => {
@@ -148,20 +160,31 @@ pub fn run(args: StrikeArgs) -> Result<()> {
                     default_listener(&bank, p.surface_point, n)?
                 }
             };
-            let heard = listener_gains(&args.bank, &bank, listener, args.solve_radiation)?;
+            let heard = listener_gains(&args.bank, &bank, listener, args.solve_radiation, args.rate as f64)?;
+            let phases: Arc<dyn OutputModulation> = Arc::new(ConstantFactors::new(heard.phases));
             (
                 OutputGain::PerMode(heard.gains),
+                Some(phases),
                 OutputJson { kind: "listener", listener_m: Some(listener), transfer: Some(heard.source) },
             )
         }
     };
     let options = SynthOptions { sample_rate: args.rate as f64, gain, ..SynthOptions::default() };
+    if let Some(d) = args.duration {
+        let late = strikes.iter().filter(|s| s.time_s >= d).count();
+        ensure!(
+            late < n,
+            "every strike is at or after the end of the --duration {d} s: the file would be silent"
+        );
+        if late > 0 {
+            warn(&format!("{late} strike(s) at or after the end of the --duration {d} s are not heard"));
+        }
+    }
     let length = match args.duration {
         Some(d) => RenderLength::Fixed(d),
         None => RenderLength::Auto { cap_s: AUTO_DURATION_CAP_S },
     };
-    modal_synth::check_sample_rate(args.rate as f64)?;
-    let rendered = render_strikes(&bank, &strikes, &options, length)?;
+    let rendered = render_strikes_modulated(&bank, &strikes, &options, length, phases)?;
     let top_modes = top_modes(&bank, &strikes[0], &options)?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let gain = if args.normalize { WavGain::Normalize { peak: NORMALIZED_PEAK } } else { WavGain::default() };

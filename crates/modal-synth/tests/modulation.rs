@@ -12,7 +12,9 @@ mod common;
 
 use std::sync::Arc;
 
-use modal_synth::{Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions, C64};
+use modal_synth::{
+    ConstantFactors, Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions, C64,
+};
 
 /// `m_i(t) = c_i e^{(α_i + iΩ_i) t}`, or `cos(Ω_i t + φ_i)` (a dipole seen
 /// from a body spinning at Ω_i).
@@ -169,6 +171,24 @@ fn unit_factors_equal_the_unmodulated_voice() {
     let peak = b.iter().fold(0.0f32, |m, x| m.max(x.abs())) as f64;
     let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs() as f64));
     assert!(err < 1e-6 * peak, "{err} vs {peak}");
+}
+
+#[test]
+fn constant_factors_are_a_fixed_complex_gain_per_mode() {
+    // What `strike` hears at a listener: `Re(c_i W_i z_i)` with each mode's
+    // transfer phase `c_i`, here against the per-sample reference.
+    let bank = bank();
+    let gains = vec![1.0, 0.5, 0.8, 0.3];
+    let c = vec![C64::new(0.6, 0.8), C64::new(-1.0, 0.0), C64::new(0.0, -1.0), C64::new(0.28, -0.96)];
+    let fixed = Source { kind: Kind::Exponential, params: c.iter().map(|&c| (c, 0.0, 0.0)).collect() };
+    let want = reference(&bank, &gains, &fixed);
+    let mut v = ModalVoice::new(&bank, opts(gains, OutputQuantity::Velocity, Kernel::Auto)).unwrap();
+    v.set_modulation(Arc::new(ConstantFactors::new(c)));
+    strike(&mut v);
+    let mut got = vec![0.0f32; LEN];
+    v.render(&mut got, 0);
+    let (err, peak) = max_err(&got, &want);
+    assert!(peak > 1e-3 && err < 1e-5 * peak, "{err} vs peak {peak}");
 }
 
 /// Cost of the modulation against real gains: a 600-mode voice, 2 s at
