@@ -375,6 +375,26 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert!(info["modes"][0]["radiated_power_w"].is_null(), "modes not solved stay null");
     let table_text = modal(dir.path(), &["info", "rad.bank"]).ok().stdout;
     assert!(table_text.contains("radiated W"), "{table_text}");
+    // One more mode adds to the stored transfer; the others are kept bit for bit.
+    modal(dir.path(), &["radiation", "rad.bank", "--mode", "7", "--store", "more.bank"]).ok();
+    let (_, more) = ModeBank::load_with_radiation(dir.path().join("more.bank")).unwrap();
+    let more = more.unwrap();
+    assert_eq!(more.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [5, 7, 10]);
+    assert_eq!(more.mode(5), table.mode(5));
+    assert_eq!(more.mode(10), table.mode(10));
+    // Transfers for other air do not mix with the new ones: dropped, and said.
+    let other = modal(
+        dir.path(),
+        &["radiation", "more.bank", "--mode", "7", "--sound-speed", "340", "--store", "c.bank"],
+    )
+    .ok();
+    assert!(other.stderr.contains("2 transfer(s) stored for other modes"), "{}", other.stderr);
+    let (_, c) = ModeBank::load_with_radiation(dir.path().join("c.bank")).unwrap();
+    assert_eq!(c.unwrap().modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [7]);
+    // A store that cannot be written fails before the solve (the pre-flight's words).
+    modal(dir.path(), &["radiation", "sphere.bank", "--store", "missing/x.bank"])
+        .fails_with("does not exist");
+    modal(dir.path(), &["radiation", "sphere.bank", "--store", "."]).fails_with("is a directory");
 }
 
 #[test]

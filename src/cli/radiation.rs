@@ -6,12 +6,12 @@ use std::time::Instant;
 
 use anyhow::{ensure, Context, Result};
 use clap::Args;
-use modal_bank::ModeBank;
+use modal_bank::{ModeBank, RadiationTable};
 use modal_radiation::{Air, BoundaryMesh, RadiationOptions};
 use serde::Serialize;
 
 use super::bank_cmds::load_bank;
-use super::output::print_json;
+use super::output::{print_json, warn};
 
 #[derive(Debug, Args)]
 pub struct RadiationArgs {
@@ -114,8 +114,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         ensure!(m < bank.mode_count(), "mode {m} does not exist (the bank has {} modes)", bank.mode_count());
     }
     if let Some(path) = &args.store {
-        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-        ensure!(dir.is_dir(), "--store {}: directory {} does not exist", path.display(), dir.display());
+        super::check_writable(path).with_context(|| format!("--store {}", path.display()))?;
     }
     let mut candidates: Vec<usize> =
         if args.mode.is_empty() { (0..bank.mode_count()).collect() } else { args.mode.clone() };
@@ -129,7 +128,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         skipped.len()
     );
     if modes.is_empty() {
-        super::output::warn(&format!(
+        warn(&format!(
             "no audible mode to solve (none at {} Hz or more and at most --max-freq {} Hz)",
             modal_radiation::modes::AUDIBLE_MIN_HZ,
             args.max_freq
@@ -159,6 +158,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     if let Some(path) = &args.store {
         match modal_radiation::modes::to_table(&results, &opts) {
             Some(table) => {
+                let table = keep_other_modes(table, super::listener::stored_radiation(&args.bank)?, &bank);
                 super::interrupt::guarded(|| bank.save_with_radiation(path, &table))
                     .with_context(|| format!("cannot write bank {}", path.display()))?;
                 eprintln!("radiation: stored {} mode(s) in {}", table.modes.len(), path.display());
@@ -204,4 +204,41 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The table to store: `solved` (this run's modes) plus the entries the
+/// input bank already held for other modes, so `--mode I` or a lower
+/// `--max-freq` adds to a stored transfer instead of dropping the rest. An
+/// old entry is kept only where it describes the same problem: the same
+/// expansion centre, fit radius, air and tolerance, and a wavenumber within
+/// the solver's grouping tolerance of the mode's frequency now; otherwise
+/// the old entries are dropped, and a warning says how many.
+fn keep_other_modes(solved: RadiationTable, old: Option<RadiationTable>, bank: &ModeBank) -> RadiationTable {
+    let Some(old) = old else { return solved };
+    let others: Vec<_> = old.modes.into_iter().filter(|m| solved.mode(m.mode).is_none()).collect();
+    if others.is_empty() {
+        return solved;
+    }
+    let same_problem = old.centre_m == solved.centre_m
+        && old.fit_radius_m == solved.fit_radius_m
+        && old.air_density_kg_m3 == solved.air_density_kg_m3
+        && old.sound_speed_m_s == solved.sound_speed_m_s
+        && old.tolerance == solved.tolerance;
+    let tolerance = RadiationOptions::default().group_tolerance;
+    let (kept, stale): (Vec<_>, Vec<_>) = others.into_iter().partition(|m| {
+        let f = m.wavenumber * solved.sound_speed_m_s / (2.0 * std::f64::consts::PI);
+        let now = bank.frequencies_hz.get(m.mode).copied().unwrap_or(f64::NAN);
+        same_problem && (f - now).abs() <= tolerance * now
+    });
+    if !stale.is_empty() {
+        warn(&format!(
+            "{} transfer(s) stored for other modes were solved for other air, another surface or other \
+             frequencies: not kept (solve them again with `modal radiation`)",
+            stale.len()
+        ));
+    }
+    let mut table = solved;
+    table.modes.extend(kept);
+    table.modes.sort_by_key(|m| m.mode);
+    table
 }
