@@ -391,6 +391,34 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert!(other.stderr.contains("2 transfer(s) stored for other modes"), "{}", other.stderr);
     let (_, c) = ModeBank::load_with_radiation(dir.path().join("c.bank")).unwrap();
     assert_eq!(c.unwrap().modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [7]);
+    // Retuned to twice the size (every ka kept) the transfer is rescaled, and
+    // agrees with a new solve of the retuned bank; a damping change keeps it.
+    modal(dir.path(), &["retune", "rad.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    let far2 = far.map(|x| 2.0 * x);
+    let p2 = format!("{},{},{}", far2[0], far2[1], far2[2]);
+    let resolved = modal(
+        dir.path(),
+        &["radiation", "big.bank", "--point", &p2, "--mode", "5", "--mode", "10", "--json"],
+    )
+    .ok()
+    .json();
+    let (_, big) = ModeBank::load_with_radiation(dir.path().join("big.bank")).unwrap();
+    let big = big.expect("a size retune keeps the transfer");
+    for m in resolved["modes"].as_array().unwrap() {
+        let entry = big.mode(m["index"].as_u64().unwrap() as usize).unwrap();
+        let z = modal_radiation::modes::stored_multipole(&big, entry).pressure_at(far2);
+        let want =
+            c64::new(m["pressure_pa"][0][0].as_f64().unwrap(), m["pressure_pa"][0][1].as_f64().unwrap());
+        assert!((z - want).norm() < 0.02 * want.norm(), "mode {}: rescaled {z} vs solved {want}", m["index"]);
+        let power = m["radiated_power_w"].as_f64().unwrap();
+        assert!((entry.power_w / power - 1.0).abs() < 0.01, "power {} vs {power}", entry.power_w);
+    }
+    modal(dir.path(), &["retune", "rad.bank", "--alpha", "3", "-o", "damped.bank"]).ok();
+    let (_, damped) = ModeBank::load_with_radiation(dir.path().join("damped.bank")).unwrap();
+    assert_eq!(damped.as_ref(), Some(&table), "a damping change keeps the transfer as it is");
+    let stiffer = modal(dir.path(), &["retune", "rad.bank", "--youngs", "2e8", "-o", "stiff.bank"]).ok();
+    assert!(stiffer.stderr.contains("does not carry over"), "{}", stiffer.stderr);
+    assert!(ModeBank::load_with_radiation(dir.path().join("stiff.bank")).unwrap().1.is_none());
     // A store that cannot be written fails before the solve (the pre-flight's words).
     modal(dir.path(), &["radiation", "sphere.bank", "--store", "missing/x.bank"])
         .fails_with("does not exist");

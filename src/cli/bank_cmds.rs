@@ -53,9 +53,27 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         "nothing to retune: give --material NAME, --youngs/--density, and/or --scale S"
     );
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
-    let new = modal_bank::retune(&bank, RetuneSpec { material, scale: args.scale })?;
-    interrupt::guarded(|| new.save(&args.out))
-        .with_context(|| format!("cannot write bank {}", args.out.display()))?;
+    let spec = RetuneSpec { material, scale: args.scale };
+    let new = modal_bank::retune(&bank, spec.clone())?;
+    let transfer = match super::listener::stored_radiation(&args.bank)? {
+        Some(table) => {
+            let carried = modal_bank::retune_radiation(&bank, &table, &spec);
+            if carried.is_none() {
+                super::output::warn(&format!(
+                    "the stored acoustic transfer does not carry over: E/ρ changed, so every mode sits at a new \
+                     ka. Solve it again: modal radiation {0} --store {0}",
+                    args.out.display()
+                ));
+            }
+            carried
+        }
+        None => None,
+    };
+    interrupt::guarded(|| match &transfer {
+        Some(table) => new.save_with_radiation(&args.out, table),
+        None => new.save(&args.out),
+    })
+    .with_context(|| format!("cannot write bank {}", args.out.display()))?;
     show(&new, args.json)?;
     if !args.json {
         println!("wrote {}", args.out.display());

@@ -11,7 +11,7 @@
 //! and needs a new solve.
 
 use crate::validate::check_material;
-use crate::{BankError, CacheKey, ModeBank};
+use crate::{BankError, CacheKey, ModeBank, RadiationTable};
 use modal_fem::Material;
 
 /// Prefix of the `input_hash` of a retuned bank.
@@ -33,36 +33,93 @@ const POISSON_TOL: f64 = 1e-12;
 /// `info.input_hash` becomes `retuned:<hex>` (hash of the old hash and the
 /// spec), so it is never served as a cache hit for a fresh solve.
 pub fn retune(bank: &ModeBank, spec: RetuneSpec) -> Result<ModeBank, BankError> {
-    let old = &bank.material;
-    let new = spec.material.clone().unwrap_or_else(|| old.clone());
-    check_material(&new)?;
-    if (new.poisson - old.poisson).abs() > POISSON_TOL {
-        return Err(BankError::PoissonChanged { bank: old.poisson, requested: new.poisson });
-    }
-    let gamma = spec.scale.unwrap_or(1.0);
-    if !(gamma.is_finite() && gamma > 0.0) {
-        return Err(BankError::InvalidScale(gamma));
-    }
-    let stiffness = new.youngs_pa / old.youngs_pa;
-    let density = new.density_kg_m3 / old.density_kg_m3;
-    let freq_factor = (stiffness / density).sqrt() / gamma;
-    let shape_factor = (1.0 / density).sqrt() * gamma.powf(-1.5);
+    let f = Factors::of(bank, &spec)?;
+    let (gamma, density) = (f.gamma, f.density);
     let (g3, g5) = (gamma.powi(3), gamma.powi(5));
 
     let mut out = bank.clone();
-    out.frequencies_hz.iter_mut().for_each(|f| *f *= freq_factor);
-    out.shapes.iter_mut().for_each(|v| *v = (f64::from(*v) * shape_factor) as f32);
+    out.frequencies_hz.iter_mut().for_each(|x| *x *= f.frequency);
+    out.shapes.iter_mut().for_each(|v| *v = (f64::from(*v) * f.shape) as f32);
     out.surface.positions.iter_mut().flatten().for_each(|x| *x *= gamma);
     let m = &mut out.mass;
     m.volume_m3 *= g3;
     m.mass_kg *= g3 * density;
     m.center_of_mass_m.iter_mut().for_each(|x| *x *= gamma);
     m.inertia_kg_m2.iter_mut().flatten().for_each(|x| *x *= g5 * density);
-    out.material = new;
+    out.material = spec.material.clone().unwrap_or_else(|| bank.material.clone());
     out.recompute_damping();
     out.info.input_hash = retuned_hash(bank, &spec, gamma);
     out.validate()?;
     Ok(out)
+}
+
+/// The stored acoustic transfer of `bank` for the bank [`retune`] makes of
+/// it with `spec`, or `None` when it does not carry over.
+///
+/// The exterior problem of a mode depends on `ka` (wavenumber times size)
+/// and is linear in the surface velocity. When `ω'γ = ω` (only the damping
+/// changes, or the size with `E/ρ` kept) every `ka` is unchanged: the field
+/// of the retuned mode at `γx` is the old one at `x` times the shape factor
+/// `s = φ'/φ`. So the centre and fit radius scale by `γ`, wavenumbers by
+/// `1/γ`, coefficients (of `h_l(kr)`, `kr` unchanged) by `s`, power by
+/// `s²γ²`, and the efficiency stays. Otherwise (`E/ρ` changed) the modes
+/// sit at new `ka`, and only a new solve gives their transfer.
+pub fn retune_radiation(
+    bank: &ModeBank,
+    table: &RadiationTable,
+    spec: &RetuneSpec,
+) -> Option<RadiationTable> {
+    let f = Factors::of(bank, spec).ok()?;
+    if (f.frequency * f.gamma - 1.0).abs() > KA_TOL {
+        return None;
+    }
+    let mut out = table.clone();
+    out.centre_m.iter_mut().for_each(|x| *x *= f.gamma);
+    out.fit_radius_m *= f.gamma;
+    for m in &mut out.modes {
+        m.wavenumber /= f.gamma;
+        m.coefficients.iter_mut().flatten().for_each(|c| *c *= f.shape);
+        m.power_w *= f.shape * f.shape * f.gamma * f.gamma;
+    }
+    Some(out)
+}
+
+/// Largest relative change of `ka` taken as none (rounding of `√(E'ρ/Eρ')`).
+const KA_TOL: f64 = 1e-12;
+
+/// The exact scale factors of a retune (module doc).
+struct Factors {
+    /// Geometric scale γ.
+    gamma: f64,
+    /// ρ'/ρ.
+    density: f64,
+    /// ω'/ω = √((E'/E)/(ρ'/ρ)) / γ.
+    frequency: f64,
+    /// φ'/φ = √(ρ/ρ') γ^{-3/2}.
+    shape: f64,
+}
+
+impl Factors {
+    fn of(bank: &ModeBank, spec: &RetuneSpec) -> Result<Factors, BankError> {
+        let old = &bank.material;
+        let new = spec.material.as_ref().unwrap_or(old);
+        check_material(new)?;
+        if (new.poisson - old.poisson).abs() > POISSON_TOL {
+            return Err(BankError::PoissonChanged { bank: old.poisson, requested: new.poisson });
+        }
+        let gamma = spec.scale.unwrap_or(1.0);
+        if !(gamma.is_finite() && gamma > 0.0) {
+            return Err(BankError::InvalidScale(gamma));
+        }
+        let stiffness = new.youngs_pa / old.youngs_pa;
+        let density = new.density_kg_m3 / old.density_kg_m3;
+        Ok(Factors {
+            gamma,
+            density,
+            frequency: (stiffness / density).sqrt() / gamma,
+            shape: (1.0 / density).sqrt() * gamma.powf(-1.5),
+        })
+    }
 }
 
 fn retuned_hash(bank: &ModeBank, spec: &RetuneSpec, gamma: f64) -> String {
