@@ -95,6 +95,15 @@ fn bad_strikes_fail_cleanly_without_output() {
         (vec!["strike", "bar.bank", at[0], at[1], "--rate", "0", "-o", "x.wav"], "sample rate"),
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "-1", "-o", "x.wav"], "duration"),
         (vec!["strike", "bar.bank", at[0], at[1], "--time", "1", "--time", "2", "-o", "x.wav"], "--time"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--duration", "0", "-o", "x.wav"], "above 0 s"),
+        // Not blamed on a weak impulse: no strike falls inside the file.
+        (
+            vec!["strike", "bar.bank", at[0], at[1], "--time", "2", "--duration", "1", "-o", "x.wav"],
+            "every strike",
+        ),
+        // Refused before any work (a --solve-radiation would be wasted).
+        (vec!["strike", "bar.bank", "--solve-radiation", "-o", "no/x.wav"], "directory no does not exist"),
+        (vec!["strike", "bar.bank", "--solve-radiation", "-o", "."], "is a directory"),
     ];
     for (args, needle) in cases {
         modal(dir.path(), &args).fails_with(needle);
