@@ -120,6 +120,27 @@ fn bad_scenes_name_the_field_and_write_nothing() {
 }
 
 #[test]
+fn side_files_that_cannot_be_written_are_refused_before_the_render() {
+    // Each used to be found after the render, with the WAV already written
+    // (or, for a shared path, overwritten by the next output).
+    let dir = temp_dir();
+    std::fs::write(dir.path().join("s.toml"), TWO_BLOCKS).unwrap();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let render = |extra: &[&str]| {
+        let mut a = vec!["render", "s.toml", "-o", "out/s.wav", "--radiation", "estimate"];
+        a.extend_from_slice(extra);
+        modal(dir.path(), &a)
+    };
+    render(&["--events", "out/s.wav"]).fails_with("name the same file");
+    render(&["--spectrogram", "out/../out/e.json", "--events", "out/e.json"])
+        .fails_with("name the same file");
+    render(&["--events", "missing/e.json"]).fails_with("does not exist");
+    render(&["--spectrogram", "out"]).fails_with("is a directory");
+    let written = files_in(&dir.path().join("out"));
+    assert!(written.is_empty(), "nothing written: {written:?}");
+}
+
+#[test]
 fn a_generated_shape_beyond_the_memory_guard_is_refused_before_it_is_generated() {
     let dir = temp_dir();
     // 2 mm cells: 12 000 quadratic tets, at least 0.13 GB of matrices; the guard is 0.05 GB.

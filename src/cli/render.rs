@@ -436,6 +436,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
     }
+    check_outputs(&out, &args)?;
     let spinner = Spinner::new("preparing the scene");
     let mut provider = PipelineProvider {
         cache: open_cache(args.cache_dir.as_deref(), false)?,
@@ -472,17 +473,27 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let rendered = rendered.context("render failed")?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
-    let wav = interrupt::guarded(|| modal_scene::write_wav(&rendered, &out, format))?;
+    // The side files first, the sound last; a failure removes what this run
+    // wrote, so a render never leaves a WAV without the files asked with it.
+    let mut written: Vec<&Path> = Vec::new();
+    let result = (|| -> Result<modal_synth::WavReport> {
+        if let Some(path) = &args.events {
+            interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))
+                .with_context(|| format!("cannot write --events {}", path.display()))?;
+            written.push(path);
+        }
+        if let Some(path) = &args.spectrogram {
+            interrupt::guarded(|| {
+                modal_scene::write_spectrogram_png(&rendered.channels, rendered.sample_rate, path)
+            })
+            .with_context(|| format!("cannot write --spectrogram {}", path.display()))?;
+            written.push(path);
+        }
+        Ok(interrupt::guarded(|| modal_scene::write_wav(&rendered, &out, format))?)
+    })();
+    let wav = result.inspect_err(|_| written.iter().for_each(|p| drop(std::fs::remove_file(p))))?;
     if wav.clipped > 0 {
         warn(&clipping_advice(wav.clipped, rendered.report.peak, scene.listener.gain));
-    }
-    if let Some(path) = &args.events {
-        interrupt::guarded(|| modal_scene::write_events_json(&rendered.contact_events(), path))?;
-    }
-    if let Some(path) = &args.spectrogram {
-        interrupt::guarded(|| {
-            modal_scene::write_spectrogram_png(&rendered.channels, rendered.sample_rate, path)
-        })?;
     }
     let report = &rendered.report;
     if args.json {
@@ -562,6 +573,36 @@ fn clipping_advice(clipped: usize, peak: f64, gain: f64) -> String {
          [listener] gain = {fitting:.decimals$} (now {gain}) would fit it, or --float keeps it unclipped",
         peak * 20.0 / gain
     )
+}
+
+/// Before any work: the WAV, `--events` and `--spectrogram` are three
+/// different files, each of which can be written (a shared path would have
+/// each write replace the one before).
+fn check_outputs(out: &Path, args: &RenderArgs) -> Result<()> {
+    let named = [
+        ("-o", Some(out)),
+        ("--events", args.events.as_deref()),
+        ("--spectrogram", args.spectrogram.as_deref()),
+    ];
+    let named: Vec<(&str, &Path)> = named.into_iter().filter_map(|(flag, p)| Some((flag, p?))).collect();
+    for (k, (flag, path)) in named.iter().enumerate() {
+        super::check_writable(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
+        for (other, earlier) in &named[..k] {
+            anyhow::ensure!(
+                output_identity(path) != output_identity(earlier),
+                "{flag} and {other} name the same file {}: give each output its own path",
+                path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `path` with its directory resolved, to compare outputs.
+fn output_identity(path: &Path) -> PathBuf {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    dir.join(path.file_name().unwrap_or_default())
 }
 
 #[cfg(test)]
