@@ -134,3 +134,34 @@ fn a_strike_that_rounds_to_silence_says_so() {
     let heard = modal(dir.path(), &["strike", "bar.bank", "-o", "heard.wav"]).ok();
     assert!(!heard.stderr.contains("16-bit"), "{}", heard.stderr);
 }
+
+#[test]
+fn tables_number_modes_as_json_and_radiation_mode_do() {
+    // One numbering everywhere: from 0, as `--json`, `radiation --mode` and
+    // every error message count (info and strike's tables counted from 1).
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let info = modal(dir.path(), &["info", "bar.bank"]).ok().stdout;
+    let header = info.lines().position(|l| l.trim_start().starts_with("mode ")).unwrap();
+    let first_row = info.lines().nth(header + 1).unwrap();
+    let f0 = modal(dir.path(), &["info", "bar.bank", "--json"]).ok().json()["modes"][0]["frequency_hz"]
+        .as_f64()
+        .unwrap();
+    let cells: Vec<&str> = first_row.split_whitespace().collect();
+    assert_eq!(cells[0], "0", "{first_row}");
+    assert!((cells[1].parse::<f64>().unwrap() - f0).abs() < 1e-3, "{first_row} vs {f0}");
+    let args = ["strike", "bar.bank", "--at", "0.05,0.01,0.01", "--duration", "0.1", "-o", "s.wav"];
+    let human = modal(dir.path(), &args).ok().stdout;
+    let json = modal(dir.path(), &[&args[..], &["--json"]].concat()).ok().json();
+    let listed: Vec<u64> = human
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix("mode "))
+        .map(|rest| rest.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    let want: Vec<u64> =
+        json["top_modes"].as_array().unwrap().iter().map(|m| m["mode"].as_u64().unwrap()).collect();
+    assert!(!want.is_empty());
+    assert_eq!(listed, want);
+    // Pressure at the listener is printed in Pa, not the contact microphone's m/s.
+    assert!(human.contains(" Pa  T60"), "{human}");
+}

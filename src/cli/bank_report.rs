@@ -142,11 +142,7 @@ impl BankJson {
             write!(
                 out,
                 "{:>5}  {:>14.3}  {:>13.3e}  {:>11}  {:>10.2e}",
-                i + 1,
-                mode.frequency_hz,
-                mode.damping_ratio,
-                t60,
-                mode.residual
+                i, mode.frequency_hz, mode.damping_ratio, t60, mode.residual
             )?;
             if estimated {
                 let e = mode.error_estimate_pct.map_or("-".to_string(), |e| format!("{e:.3}"));

@@ -5,6 +5,7 @@
 
 use anyhow::{bail, ensure, Context, Result};
 use modal_bank::ModeBank;
+use modal_scene::FULL_SCALE_PA;
 use modal_synth::{
     contact, render_strikes_modulated, ConstantFactors, OutputGain, OutputModulation, RenderLength, Strike,
     SynthModel, SynthOptions, WavFormat, WavGain, DEFAULT_CONTACT_TIME_S,
@@ -304,13 +305,15 @@ fn print_human(json: &StrikeJson) {
         _ => println!("output: contact microphone, normal surface velocity, full scale 1 m/s"),
     }
     println!("contact time {:.3e} s; loudest modes excited by the first strike:", json.contact_time_s);
+    // Amplitudes are in output units: 20 Pa at the listener, 1 m/s at a contact microphone.
+    let (unit, scale) = if json.output.listener_m.is_some() { ("Pa", FULL_SCALE_PA) } else { ("m/s", 1.0) };
     for m in &json.top_modes {
         let t60 = m.t60_s.map_or("inf".into(), |t| format!("{t:.3} s"));
         println!(
-            "  mode {:>3}  {:>10.2} Hz  amplitude {:.3e} m/s  T60 {}",
-            m.mode + 1,
+            "  mode {:>3}  {:>10.2} Hz  amplitude {:.3e} {unit}  T60 {}",
+            m.mode,
             m.frequency_hz,
-            m.amplitude,
+            m.amplitude * scale,
             t60
         );
     }
