@@ -79,6 +79,9 @@ fn impossible_materials() {
         (vec!["--youngs", "200e9", "--poisson", "0.3", "--density", "0"], "density"),
         (vec!["--material", "unobtainium"], "unobtainium"),
         (vec!["--youngs", "200e9"], "material"),
+        // A unit mistake (GPa given as Pa, g/cm³ as kg/m³) or a typo: said, not solved.
+        (vec!["--youngs", "200", "--poisson", "0.3", "--density", "7850"], "is it in Pa"),
+        (vec!["--youngs", "200e9", "--poisson", "0.3", "--density", "1e-300"], "is it in kg/m³"),
     ] {
         let mut args = vec!["precompute", "good.msh", "-o", "out.bank"];
         args.extend(flags);

@@ -96,6 +96,9 @@ fn retune_matches_a_fresh_solve() {
     assert_eq!(retuned["cached"], false);
     // A different ν needs a new solve.
     modal(dir.path(), &["retune", "steel.bank", "--poisson", "0.33", "-o", "x.bank"]).fails_with("poisson");
+    // Absurd values are refused by name (they gave "not finite" of an internal field).
+    modal(dir.path(), &["retune", "steel.bank", "--scale", "1e200", "-o", "x.bank"]).fails_with("--scale");
+    modal(dir.path(), &["retune", "steel.bank", "--density", "1e-300", "-o", "x.bank"]).fails_with("density");
     assert!(!dir.path().join("x.bank").exists());
 }
 

@@ -52,6 +52,15 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         material_given || args.scale.is_some(),
         "nothing to retune: give --material NAME, --youngs/--density, and/or --scale S"
     );
+    if let Some(gamma) = args.scale {
+        let range = modal_mesh::SCALE_RANGE;
+        anyhow::ensure!(
+            range.contains(&gamma),
+            "--scale must be a factor on every length from {:e} to {:e} (got {gamma:e})",
+            range.start(),
+            range.end()
+        );
+    }
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
     let spec = RetuneSpec { material, scale: args.scale };
     let new = modal_bank::retune(&bank, spec.clone())?;

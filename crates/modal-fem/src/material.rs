@@ -57,6 +57,13 @@ struct Preset {
     beta: f64,
 }
 
+/// Young's moduli accepted [Pa]: from soft gels (≈ 10³) to beyond diamond
+/// (≈ 1.1·10¹²). Outside, a value is a unit mistake, and the solve would
+/// end in "did not converge" or frequencies of 10¹⁵² Hz.
+pub const YOUNGS_RANGE_PA: std::ops::RangeInclusive<f64> = 1e3..=1e13;
+/// Densities accepted [kg/m³]: from aerogels (≈ 0.2) to beyond osmium (22 590).
+pub const DENSITY_RANGE_KG_M3: std::ops::RangeInclusive<f64> = 0.1..=1e5;
+
 const fn preset(
     name: &'static str,
     density: f64,
@@ -204,8 +211,12 @@ impl Material {
     /// Checks physical admissibility: E > 0, −1 < ν < 0.5, ρ > 0, α ≥ 0,
     /// β ≥ 0, all finite. The error names the offending field and value.
     pub fn validate(&self) -> Result<(), MaterialError> {
-        let bad =
-            |what: &str, v: f64, rule: &str| Err(MaterialError::Invalid(format!("{what} = {v} ({rule})")));
+        let bad = |what: &str, v: f64, rule: &str| {
+            // 1e-300, not three hundred zeros.
+            let v =
+                if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
+            Err(MaterialError::Invalid(format!("{what} = {v} ({rule})")))
+        };
         let fields = [
             ("Young's modulus E [Pa]", self.youngs_pa),
             ("Poisson's ratio ν", self.poisson),
@@ -219,11 +230,25 @@ impl Material {
         if self.youngs_pa <= 0.0 {
             return bad(fields[0].0, self.youngs_pa, "must be > 0");
         }
+        if !YOUNGS_RANGE_PA.contains(&self.youngs_pa) {
+            return bad(
+                fields[0].0,
+                self.youngs_pa,
+                "softer than a gel or stiffer than diamond: solids lie within 1e3 to 1e13 Pa; is it in Pa?",
+            );
+        }
         if !(self.poisson > -1.0 && self.poisson < 0.5) {
             return bad(fields[1].0, self.poisson, "must satisfy -1 < ν < 0.5");
         }
         if self.density_kg_m3 <= 0.0 {
             return bad(fields[2].0, self.density_kg_m3, "must be > 0");
+        }
+        if !DENSITY_RANGE_KG_M3.contains(&self.density_kg_m3) {
+            return bad(
+                fields[2].0,
+                self.density_kg_m3,
+                "lighter than an aerogel or denser than osmium: solids lie within 0.1 to 1e5 kg/m³; is it in kg/m³?",
+            );
         }
         if self.alpha < 0.0 {
             return bad(fields[3].0, self.alpha, "must be >= 0");
@@ -291,6 +316,13 @@ mod tests {
         assert!(!ok(200e9, 0.3, 7850.0, 0.0, -1e-9));
         assert!(!ok(f64::NAN, 0.3, 7850.0, 0.0, 0.0));
         assert!(!ok(200e9, 0.3, f64::INFINITY, 0.0, 0.0));
+        // Absurd values (a unit mistake, a typo) are refused, not solved into
+        // "did not converge" or 1e152 Hz.
+        for (e, rho) in [(1e300, 7850.0), (200.0, 7850.0), (200e9, 1e-300), (200e9, 1e300)] {
+            let why = Material::custom(e, 0.3, rho, 0.0, 0.0).unwrap_err().to_string();
+            assert!(why.contains("is it in"), "E {e}, ρ {rho}: {why}");
+        }
+        assert!(ok(1e3, 0.3, 0.1, 0.0, 0.0) && ok(1e13, 0.3, 1e5, 0.0, 0.0));
         let msg = Material::custom(200e9, 0.5, 7850.0, 0.0, 0.0).unwrap_err().to_string();
         assert!(msg.contains("Poisson") && msg.contains("0.5"), "{msg}");
     }
