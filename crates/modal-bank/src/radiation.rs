@@ -15,6 +15,12 @@
 
 use crate::BankError;
 
+/// Largest fit radius accepted, in body radii about the centre.
+pub const MAX_FIT_RADII: f64 = 1000.0;
+/// Largest relative distance accepted between a stored wavenumber's
+/// frequency `kc/2π` and its mode's (the solver groups modes within 10⁻³).
+pub const WAVENUMBER_TOL: f64 = 0.01;
+
 /// The stored far-field representation of some of a bank's modes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiationTable {
@@ -54,6 +60,65 @@ impl RadiationTable {
     /// The entry of mode `mode`, if stored.
     pub fn mode(&self, mode: usize) -> Option<&ModeTransfer> {
         self.modes.binary_search_by_key(&mode, |m| m.mode).ok().map(|i| &self.modes[i])
+    }
+
+    /// [`RadiationTable::validate`], then the table against the bank it is
+    /// stored with: the centre within the surface's bounding box, the fit
+    /// sphere enclosing the surface (and at most [`MAX_FIT_RADII`] body radii),
+    /// and each wavenumber within [`WAVENUMBER_TOL`] of its mode's frequency.
+    /// A table that passes the first check alone (a crafted or damaged file
+    /// with a valid checksum, a centre at 1e300 m) gave NaN gains later.
+    pub fn validate_for(&self, bank: &crate::ModeBank) -> Result<(), BankError> {
+        self.validate(bank.mode_count())?;
+        let bad = |field: String, value: f64, rule: &str| {
+            Err(BankError::OutOfRange { field, value, rule: rule.into() })
+        };
+        let points = &bank.surface.positions;
+        if !points.is_empty() {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for p in points {
+                for q in 0..3 {
+                    lo[q] = lo[q].min(p[q]);
+                    hi[q] = hi[q].max(p[q]);
+                }
+            }
+            let diagonal = (0..3).map(|q| (hi[q] - lo[q]).powi(2)).sum::<f64>().sqrt();
+            let slack = 1e-6 * diagonal;
+            for q in 0..3 {
+                let c = self.centre_m[q];
+                if c < lo[q] - slack || c > hi[q] + slack {
+                    return bad(
+                        format!("radiation.centre_m[{q}]"),
+                        c,
+                        "must lie within the surface's bounding box",
+                    );
+                }
+            }
+            let body_radius = points
+                .iter()
+                .map(|p| (0..3).map(|q| (p[q] - self.centre_m[q]).powi(2)).sum::<f64>().sqrt())
+                .fold(0.0, f64::max);
+            let fit = self.fit_radius_m;
+            if fit < body_radius * (1.0 - 1e-9) || fit > MAX_FIT_RADII * body_radius {
+                return bad(
+                    "radiation.fit_radius_m".into(),
+                    fit,
+                    "must enclose the surface, within 1000 body radii of the centre",
+                );
+            }
+        }
+        for (i, m) in self.modes.iter().enumerate() {
+            let f = m.wavenumber * self.sound_speed_m_s / (2.0 * std::f64::consts::PI);
+            let mode_hz = bank.frequencies_hz[m.mode];
+            if (f - mode_hz).abs() > WAVENUMBER_TOL * mode_hz {
+                return bad(
+                    format!("radiation_wavenumbers[{i}]"),
+                    m.wavenumber,
+                    "must be the wavenumber of its mode's frequency (within 1 %)",
+                );
+            }
+        }
+        Ok(())
     }
 
     /// Checks the table against a bank with `mode_count` modes: entries

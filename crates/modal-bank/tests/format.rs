@@ -281,11 +281,18 @@ fn version_1_banks_still_load_without_radiation() {
     assert!(table.is_none());
 }
 
+/// A table that fits `bank` (`RadiationTable::validate_for`): centred in its
+/// surface's box, fitted at twice its radius, each mode's own wavenumber.
 fn radiation_table(bank: &ModeBank) -> modal_bank::RadiationTable {
+    let p = &bank.surface.positions;
+    let centre = [0, 1, 2].map(|q| p.iter().map(|x| x[q]).sum::<f64>() / p.len() as f64);
+    let radius =
+        p.iter().map(|x| (0..3).map(|q| (x[q] - centre[q]).powi(2)).sum::<f64>().sqrt()).fold(0.0, f64::max);
+    let c = 343.0;
     let modes = (0..bank.mode_count())
         .map(|i| modal_bank::ModeTransfer {
             mode: i,
-            wavenumber: 2.0 + i as f64,
+            wavenumber: 2.0 * std::f64::consts::PI * bank.frequencies_hz[i] / c,
             order: i,
             coefficients: (0..(i + 1) * (i + 1)).map(|j| [j as f64 * 0.5, -(j as f64) / 3.0]).collect(),
             power_w: 1e-3 / (1.0 + i as f64),
@@ -293,10 +300,10 @@ fn radiation_table(bank: &ModeBank) -> modal_bank::RadiationTable {
         })
         .collect();
     modal_bank::RadiationTable {
-        centre_m: [0.01, -0.02, 0.3],
-        fit_radius_m: 0.4,
+        centre_m: centre,
+        fit_radius_m: 2.0 * radius,
         air_density_kg_m3: 1.21,
-        sound_speed_m_s: 343.0,
+        sound_speed_m_s: c,
         tolerance: 0.01,
         modes,
     }
@@ -325,9 +332,21 @@ fn radiation_table_round_trips_bit_identical_under_the_checksum() {
     let mut bad = table.clone();
     bad.modes[0].mode = 99;
     assert!(bank.to_bytes_with_radiation(&bad).is_err());
-    let mut bad = table;
+    let mut bad = table.clone();
     bad.modes[1].coefficients.pop();
     assert!(bank.to_bytes_with_radiation(&bad).is_err());
+    // Finite but not this bank's: a centre far away, a fit sphere inside the
+    // body, a wavenumber of another frequency (each gave NaN or wrong gains).
+    let mut far = table.clone();
+    far.centre_m[1] = 1e300;
+    let mut inside = table.clone();
+    inside.fit_radius_m *= 0.25;
+    let mut detuned = table.clone();
+    detuned.modes[2].wavenumber *= 1.5;
+    for (bad, field) in [(far, "centre_m"), (inside, "fit_radius_m"), (detuned, "radiation_wavenumbers[2]")] {
+        let err = bank.to_bytes_with_radiation(&bad).unwrap_err().to_string();
+        assert!(err.contains(field), "{err}");
+    }
 }
 
 #[test]

@@ -78,9 +78,13 @@ fn radiation(bank: &ModeBank) -> RadiationTable {
             efficiency: rng.range(0.0, 1.0),
         })
         .to_vec();
+    let c = bank.mass.center_of_mass_m;
+    let radius =
+        bank.surface.positions.iter().map(|p| (0..3).map(|q| (p[q] - c[q]).powi(2)).sum::<f64>().sqrt());
     RadiationTable {
-        centre_m: bank.mass.center_of_mass_m,
-        fit_radius_m: 0.1 + rng.range(0.0, 1e-3),
+        centre_m: c,
+        // Twice the body's radius, as the solver fits (the table must fit its bank).
+        fit_radius_m: 2.0 * radius.fold(0.0, f64::max) + rng.range(0.0, 1e-3),
         air_density_kg_m3: 1.21,
         sound_speed_m_s: 343.0,
         tolerance: 1e-3,

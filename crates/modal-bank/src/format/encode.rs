@@ -133,7 +133,7 @@ pub(super) fn to_bytes_with_radiation(
     let mut tensors = tensors(bank)?;
     let mut metadata = metadata(bank)?;
     if let Some(table) = radiation {
-        table.validate(bank.mode_count())?;
+        table.validate_for(bank)?;
         for (name, dtype, shape, data) in super::radiation_io::tensors(table) {
             tensors.push(Tensor { name, dtype, shape, data });
         }

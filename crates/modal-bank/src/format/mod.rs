@@ -101,7 +101,7 @@ impl ModeBank {
         bytes: &[u8],
     ) -> Result<(ModeBank, Option<crate::RadiationTable>), BankError> {
         let bank = decode::from_bytes(bytes)?;
-        let table = radiation_io::read(bytes, bank.mode_count())?;
+        let table = radiation_io::read(bytes, &bank)?;
         Ok((bank, table))
     }
 }

@@ -108,9 +108,9 @@ fn read_usize(st: &SafeTensors<'_>, name: &str) -> Result<Vec<usize>, BankError>
         .collect()
 }
 
-/// The radiation table of verified bank bytes with `mode_count` modes;
-/// `None` when the file has none.
-pub(crate) fn read(bytes: &[u8], mode_count: usize) -> Result<Option<RadiationTable>, BankError> {
+/// The radiation table of the verified bytes of `bank`, checked against it
+/// ([`RadiationTable::validate_for`]); `None` when the file has none.
+pub(crate) fn read(bytes: &[u8], bank: &crate::ModeBank) -> Result<Option<RadiationTable>, BankError> {
     let st = SafeTensors::deserialize(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
     let (_, header) =
         SafeTensors::read_metadata(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
@@ -169,6 +169,6 @@ pub(crate) fn read(bytes: &[u8], mode_count: usize) -> Result<Option<RadiationTa
         tolerance: meta.tolerance,
         modes: entries,
     };
-    table.validate(mode_count)?;
+    table.validate_for(bank)?;
     Ok(Some(table))
 }

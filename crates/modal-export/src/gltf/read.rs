@@ -510,7 +510,7 @@ fn exact_bank(doc: &Doc, extras: &Value, khr: &Khr) -> Result<(ModeBank, SideRad
     bank.shapes.shrink_to_fit();
     let radiation = match &exact.radiation {
         None => Ok(None),
-        Some(value) => radiation_table(doc, value, n).map(Some),
+        Some(value) => radiation_table(doc, value, &bank).map(Some),
     };
     Ok((bank, radiation))
 }
@@ -549,9 +549,8 @@ fn agrees_with_khr(bank: &ModeBank, material: &Material, model: &ModelJson) -> R
     Ok(())
 }
 
-/// The acoustic transfer of `extras.modal.radiation` for a bank of
-/// `mode_count` modes.
-fn radiation_table(doc: &Doc, value: &Value, mode_count: usize) -> Result<RadiationTable, String> {
+/// The acoustic transfer of `extras.modal.radiation` for `bank`.
+fn radiation_table(doc: &Doc, value: &Value, bank: &ModeBank) -> Result<RadiationTable, String> {
     let r: RadiationJson = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
     let count = r.modes.len();
     if [r.wavenumbers.len(), r.orders.len(), r.power_w.len(), r.efficiency.len()].iter().any(|&l| l != count)
@@ -585,6 +584,6 @@ fn radiation_table(doc: &Doc, value: &Value, mode_count: usize) -> Result<Radiat
         tolerance: r.tolerance,
         modes,
     };
-    table.validate(mode_count).map_err(|e| e.to_string())?;
+    table.validate_for(bank).map_err(|e| e.to_string())?;
     Ok(table)
 }

@@ -119,7 +119,7 @@ pub fn export_glb(
 ) -> Result<GlbExport, ExportError> {
     bank.validate().map_err(ExportError::InvalidBank)?;
     if let Some(table) = radiation {
-        table.validate(bank.mode_count()).map_err(ExportError::InvalidBank)?;
+        table.validate_for(bank).map_err(ExportError::InvalidBank)?;
     }
     let Underdamped { bank, radiation, left_out: overdamped_left_out } = underdamped_only(bank, radiation)?;
     let radiation = radiation.filter(|_| extras);
