@@ -1,30 +1,32 @@
 //! `modal info`, `modal retune`: commands on an existing bank (`modal export`: export.rs).
 
 use anyhow::{Context, Result};
-use modal_bank::{ModeBank, RetuneSpec};
+use modal_bank::{ModeBank, RadiationTable, RetuneSpec};
 
 use super::args::{InfoArgs, RetuneArgs};
 use super::bank_report::BankJson;
 use super::interrupt;
 use super::output::print_json;
 
-/// Loads a bank, naming the file in the error. A `.glb`/`.gltf` file is read
-/// as the bank of its modal model (KHR_audio_rigid_bodies), warnings on stderr.
-pub fn load_bank(path: &std::path::Path) -> Result<ModeBank> {
+/// Loads a bank and its stored acoustic transfer from one read of the file
+/// (so the two always come from the same version of it), naming the file in
+/// the error. A `.glb`/`.gltf` file is read as the bank of its modal model
+/// (KHR_audio_rigid_bodies), warnings on stderr.
+pub fn load_bank_with_radiation(path: &std::path::Path) -> Result<(ModeBank, Option<RadiationTable>)> {
     if modal_export::gltf::is_gltf_path(path) {
         let imported = modal_export::gltf::import_gltf_file(path)
             .with_context(|| format!("cannot load bank {}", path.display()))?;
         imported.warnings.iter().for_each(|w| super::output::warn(&format!("{}: {w}", path.display())));
-        return Ok(imported.bank);
+        return Ok((imported.bank, imported.radiation));
     }
-    ModeBank::load(path).with_context(|| format!("cannot load bank {}", path.display()))
+    ModeBank::load_with_radiation(path).with_context(|| format!("cannot load bank {}", path.display()))
 }
 
 fn show(bank: &ModeBank, json: bool) -> Result<()> {
     show_with(bank, None, json)
 }
 
-fn show_with(bank: &ModeBank, radiation: Option<&modal_bank::RadiationTable>, json: bool) -> Result<()> {
+fn show_with(bank: &ModeBank, radiation: Option<&RadiationTable>, json: bool) -> Result<()> {
     let report = BankJson::new(bank, false).with_radiation(radiation);
     if json {
         print_json(&report)
@@ -35,13 +37,12 @@ fn show_with(bank: &ModeBank, radiation: Option<&modal_bank::RadiationTable>, js
 }
 
 pub fn info(args: InfoArgs) -> Result<()> {
-    let bank = load_bank(&args.bank)?;
-    let radiation = super::listener::stored_radiation(&args.bank)?;
+    let (bank, radiation) = load_bank_with_radiation(&args.bank)?;
     show_with(&bank, radiation.as_ref(), args.json)
 }
 
 pub fn retune(args: RetuneArgs) -> Result<()> {
-    let bank = load_bank(&args.bank)?;
+    let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let material_given = args.material.material.is_some()
         || args.material.youngs.is_some()
         || args.material.density.is_some()
@@ -64,7 +65,7 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
     let spec = RetuneSpec { material, scale: args.scale };
     let new = modal_bank::retune(&bank, spec.clone())?;
-    let transfer = match super::listener::stored_radiation(&args.bank)? {
+    let transfer = match stored {
         Some(table) => {
             let carried = modal_bank::retune_radiation(&bank, &table, &spec);
             if carried.is_none() {

@@ -6,12 +6,12 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use modal_bank::ModeBank;
+use modal_bank::{ModeBank, RadiationTable};
 use modal_export::faust::{check_name, FaustModel, DEFAULT_NAME};
 use serde_json::{json, Value};
 
 use super::args::ExportArgs;
-use super::bank_cmds::load_bank;
+use super::bank_cmds::load_bank_with_radiation;
 use super::output::print_json;
 use super::write_atomic;
 
@@ -84,14 +84,18 @@ fn faust(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
     }))
 }
 
-fn gltf(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
+fn gltf(
+    bank: &ModeBank,
+    radiation: Option<&RadiationTable>,
+    args: &ExportArgs,
+    path: &Path,
+) -> Result<Value> {
     // Binary glTF only: a `.gltf` name promises JSON, and any other name
     // (`x.bank`) would be read back as something else.
     let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     anyhow::ensure!(glb, "--gltf {}: the file is binary glTF; give it a .glb name", path.display());
     let name = args.bank.file_stem().map_or_else(|| "model".into(), |n| n.to_string_lossy().into_owned());
-    let radiation = super::listener::stored_radiation(&args.bank)?;
-    let glb = modal_export::gltf::export_glb(bank, radiation.as_ref(), &name, true).context("--gltf")?;
+    let glb = modal_export::gltf::export_glb(bank, radiation, &name, true).context("--gltf")?;
     write_file(path, |w| Ok(w.write_all(&glb.bytes)?))?;
     let modes = bank.mode_count() - glb.overdamped_left_out;
     let mut line = format!(
@@ -118,14 +122,14 @@ fn gltf(bank: &ModeBank, args: &ExportArgs, path: &Path) -> Result<Value> {
 }
 
 pub fn run(args: ExportArgs) -> Result<()> {
-    let bank = load_bank(&args.bank)?;
+    let (bank, radiation) = load_bank_with_radiation(&args.bank)?;
     let mut report = serde_json::Map::new();
     report.insert("bank".into(), json!(args.bank.display().to_string()));
     if let Some(path) = &args.vtk {
         report.insert("vtk".into(), vtk(&bank, path)?);
     }
     if let Some(path) = &args.gltf {
-        report.insert("gltf".into(), gltf(&bank, &args, path)?);
+        report.insert("gltf".into(), gltf(&bank, radiation.as_ref(), &args, path)?);
     }
     if let Some(path) = &args.faust {
         report.insert("faust".into(), faust(&bank, &args, path)?);

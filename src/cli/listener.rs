@@ -32,7 +32,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use modal_bank::ModeBank;
+use modal_bank::{ModeBank, RadiationTable};
 use modal_radiation::{c64, Air, RadiationOptions};
 use modal_scene::{AIR_IMPEDANCE_PA_S_M, FULL_SCALE_PA, MIN_DISTANCE_M, SPEED_OF_SOUND_M_S};
 use modal_synth::{SynthModel, C64};
@@ -97,12 +97,13 @@ pub struct ListenerGains {
     pub source: TransferSource,
 }
 
-/// Gains for a listener at `x` (bank frame) of the bank stored at `path`,
-/// for the modes a render at `sample_rate_hz` plays (the others are never
+/// Gains for a listener at `x` (bank frame) of the bank stored at `path`
+/// with its stored transfer `table`, for the modes a render at `sample_rate_hz` plays (the others are never
 /// heard, so never solved).
 pub fn listener_gains(
     path: &Path,
     bank: &ModeBank,
+    table: Option<&RadiationTable>,
     x: [f64; 3],
     solve: bool,
     sample_rate_hz: f64,
@@ -114,7 +115,6 @@ pub fn listener_gains(
         let (f, d, xi) = (bank.frequencies_hz[i], bank.decay_rates[i], bank.damping_ratios[i]);
         modal_synth::classify_mode(f, d, xi, sample_rate_hz).is_ok()
     });
-    let table = stored_radiation(path)?;
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
         let mut heard = Heard::new(bank.mode_count());
@@ -134,7 +134,7 @@ pub fn listener_gains(
         for &i in &audible {
             match table.mode(i) {
                 Some(entry) => {
-                    let mp = modal_radiation::modes::stored_multipole(&table, entry);
+                    let mp = modal_radiation::modes::stored_multipole(table, entry);
                     heard.set(i, held_pressure(&mp, x), mp.wavenumber * r_ref);
                 }
                 None => {

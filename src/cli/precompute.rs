@@ -218,8 +218,7 @@ fn import_gltf(args: &PrecomputeArgs) -> Result<()> {
     if flags.into_iter().any(|given| given) || m.alpha.is_some() || m.beta.is_some() {
         warn("the glTF already holds modes: material flags are ignored (use `modal retune` to change them)");
     }
-    let bank = super::bank_cmds::load_bank(&args.mesh)?;
-    let radiation = super::listener::stored_radiation(&args.mesh)?;
+    let (bank, radiation) = super::bank_cmds::load_bank_with_radiation(&args.mesh)?;
     interrupt::guarded(|| match &radiation {
         Some(table) => bank.save_with_radiation(&args.out, table),
         None => bank.save(&args.out),

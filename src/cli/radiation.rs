@@ -10,7 +10,7 @@ use modal_bank::{ModeBank, RadiationTable};
 use modal_radiation::{Air, BoundaryMesh, RadiationOptions};
 use serde::Serialize;
 
-use super::bank_cmds::load_bank;
+use super::bank_cmds::load_bank_with_radiation;
 use super::output::{print_json, warn};
 
 #[derive(Debug, Args)]
@@ -102,7 +102,7 @@ struct ModeJson {
 
 pub fn run(args: RadiationArgs) -> Result<()> {
     let started = Instant::now();
-    let bank = load_bank(&args.bank)?;
+    let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let air = Air { density_kg_m3: args.air_density, sound_speed_m_s: args.sound_speed };
     air.validate()?;
     ensure!(args.max_freq > 0.0, "--max-freq must be positive");
@@ -158,7 +158,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     if let Some(path) = &args.store {
         match modal_radiation::modes::to_table(&results, &opts) {
             Some(table) => {
-                let table = keep_other_modes(table, super::listener::stored_radiation(&args.bank)?, &bank);
+                let table = keep_other_modes(table, stored.clone(), &bank);
                 super::interrupt::guarded(|| bank.save_with_radiation(path, &table))
                     .with_context(|| format!("cannot write bank {}", path.display()))?;
                 eprintln!("radiation: stored {} mode(s) in {}", table.modes.len(), path.display());

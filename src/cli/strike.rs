@@ -14,7 +14,7 @@ use serde::Serialize;
 use std::sync::Arc;
 
 use super::args::StrikeArgs;
-use super::bank_cmds::load_bank;
+use super::bank_cmds::load_bank_with_radiation;
 use super::interrupt;
 use super::listener::{default_listener, listener_gains, TransferSource};
 use super::output::{print_json, warn};
@@ -110,7 +110,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         );
     }
     super::check_writable(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
-    let bank = load_bank(&args.bank)?;
+    let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
     let at_points = if args.at.is_empty() {
         let at = farthest_surface_point(&bank).context("the bank has no surface to strike")?;
@@ -161,7 +161,14 @@ pub fn run(args: StrikeArgs) -> Result<()> {
                     default_listener(&bank, p.surface_point, n)?
                 }
             };
-            let heard = listener_gains(&args.bank, &bank, listener, args.solve_radiation, args.rate as f64)?;
+            let heard = listener_gains(
+                &args.bank,
+                &bank,
+                stored.as_ref(),
+                listener,
+                args.solve_radiation,
+                args.rate as f64,
+            )?;
             let phases: Arc<dyn OutputModulation> = Arc::new(ConstantFactors::new(heard.phases));
             (
                 OutputGain::PerMode(heard.gains),
