@@ -29,6 +29,7 @@ mod glob;
 mod manifest;
 mod run;
 mod shard;
+mod terms;
 
 pub use catalogue::{merge, Catalogue, CatalogueEntry, Library, MergeReport, ShardInfo, CATALOGUE_FILE};
 pub use glob::{expand as expand_glob, Pattern};

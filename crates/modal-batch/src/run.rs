@@ -30,6 +30,7 @@ use modal_precompute::cache_key;
 use modal_radiation::modes::{audible_modes, is_transfer_table_of, transfer_table};
 use modal_radiation::RadiationOptions;
 
+use crate::terms::in_manifest_terms;
 use crate::{Asset, BatchError, Catalogue, CatalogueEntry, Shard};
 
 /// The shortest time between two rewrites of the catalogue during a run.
@@ -159,7 +160,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> CatalogueEntry {
             // A reused bank's file was not read again, but its size still says whether
             // the file was in metres (a solve says so when it reads the file).
             let size_warning = modal_mesh::unit_warning(size_m).filter(|_| cached && !request.scale_stated);
-            warnings.extend(size_warning.map(|w| format!("{}: {w}", asset.path)));
+            warnings.extend(size_warning.map(|w| format!("{}: {}", asset.path, in_manifest_terms(&w))));
             CatalogueEntry {
                 path: asset.path.clone(),
                 bank: Some(asset.bank.clone()),
@@ -233,8 +234,8 @@ fn solve(
         }
     }
     let outcome = modal_precompute::precompute(request, options.cache.as_ref(), options.force, &mut |_| {})
-        .map_err(|e| chain(&e))?;
-    warnings.extend(outcome.warnings.iter().map(|w| format!("{}: {w}", asset.path)));
+        .map_err(|e| in_manifest_terms(&chain(&e)))?;
+    warnings.extend(outcome.warnings.iter().map(|w| format!("{}: {}", asset.path, in_manifest_terms(w))));
     let table = match asset.transfer_max_hz {
         Some(f) => in_pool(options.threads, || transfer_table(&outcome.bank, f, &radiation, &mut |_| {}))?
             .map_err(|e| format!("acoustic transfer: {}", chain(&e)))?,
