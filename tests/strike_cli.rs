@@ -131,6 +131,10 @@ fn a_strike_that_rounds_to_silence_says_so() {
     assert!(faint.stderr.contains("--impulse"), "{}", faint.stderr);
     let normalized = ["strike", "bar.bank", "-o", "n.wav", "--impulse", "1e-9", "--normalize"];
     assert!(!modal(dir.path(), &normalized).ok().stderr.contains("16-bit"));
+    // True silence is said whatever the output format (--normalize has nothing to scale).
+    let zero = ["strike", "bar.bank", "-o", "z.wav", "--impulse", "0", "--normalize", "--duration", "0.1"];
+    let zero = modal(dir.path(), &zero).ok();
+    assert!(zero.stderr.contains("is silent: the strikes excite none"), "{}", zero.stderr);
     let heard = modal(dir.path(), &["strike", "bar.bank", "-o", "heard.wav"]).ok();
     assert!(!heard.stderr.contains("16-bit"), "{}", heard.stderr);
 }

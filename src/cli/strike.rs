@@ -212,6 +212,13 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     let stats = &rendered.stats;
     if stats.modes_total == 0 {
         warn(&format!("the bank holds no mode: {} is silent", args.out.display()));
+    } else if report.peak == 0.0 && stats.modes_skipped < stats.modes_total {
+        // Nothing to scale up: --normalize and --float cannot help.
+        warn(&format!(
+            "{} is silent: the strikes excite none of the modes it plays (a zero --impulse, or a direction \
+             along which no mode moves at the struck point)",
+            args.out.display()
+        ));
     } else if !args.float
         && !args.normalize
         && report.peak < modal_synth::PCM16_SMALLEST_NONZERO
