@@ -7,11 +7,10 @@ use anyhow::{bail, ensure, Context, Result};
 use modal_bank::ModeBank;
 use modal_scene::FULL_SCALE_PA;
 use modal_synth::{
-    contact, render_strikes_modulated, ConstantFactors, OutputGain, OutputModulation, RenderLength, Strike,
-    SynthModel, SynthOptions, WavFormat, WavGain, DEFAULT_CONTACT_TIME_S,
+    contact, render_strikes, OutputGain, RenderLength, Strike, SynthModel, SynthOptions, WavFormat, WavGain,
+    DEFAULT_CONTACT_TIME_S,
 };
 use serde::Serialize;
-use std::sync::Arc;
 
 use super::args::StrikeArgs;
 use super::bank_cmds::load_bank_with_radiation;
@@ -169,15 +168,14 @@ pub fn run(args: StrikeArgs) -> Result<()> {
                 args.solve_radiation,
                 args.rate as f64,
             )?;
-            let phases: Arc<dyn OutputModulation> = Arc::new(ConstantFactors::new(heard.phases));
             (
                 OutputGain::PerMode(heard.gains),
-                Some(phases),
+                Some(heard.phases),
                 OutputJson { kind: "listener", listener_m: Some(listener), transfer: Some(heard.source) },
             )
         }
     };
-    let options = SynthOptions { sample_rate: args.rate as f64, gain, ..SynthOptions::default() };
+    let options = SynthOptions { sample_rate: args.rate as f64, gain, phases, ..SynthOptions::default() };
     if let Some(d) = args.duration {
         let late = strikes.iter().filter(|s| s.time_s >= d).count();
         ensure!(
@@ -192,7 +190,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         Some(d) => RenderLength::Fixed(d),
         None => RenderLength::Auto { cap_s: AUTO_DURATION_CAP_S },
     };
-    let rendered = render_strikes_modulated(&bank, &strikes, &options, length, phases)?;
+    let rendered = render_strikes(&bank, &strikes, &options, length)?;
     let top_modes = top_modes(&bank, &strikes[0], &options)?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let gain = if args.normalize { WavGain::Normalize { peak: NORMALIZED_PEAK } } else { WavGain::default() };

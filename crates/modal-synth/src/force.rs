@@ -66,7 +66,7 @@ use crate::error::SynthError;
 use crate::force_kernel::{self as fk, Lanes, SpanForce, TileConsts, FT};
 use crate::kernel::SimdPath;
 use crate::model::SynthModel;
-use crate::options::{classify_mode, Kernel, SynthOptions};
+use crate::options::{check_phase_count, classify_mode, phase_of, Kernel, SynthOptions};
 use crate::surface::SurfacePoint;
 use crate::voice::{weight, ImpactPoint, ABSOLUTE_FLOOR, BLOCK};
 
@@ -288,6 +288,7 @@ impl DrivenVoice {
                 scratch: fk::Scratch::default(),
             }));
         }
+        check_phase_count(v.opts.phases.as_ref(), v.model.mode_count())?;
         if let Some(g) = v.model.initial_gains(&v.opts.gain)? {
             v.set_gains(&g);
         }
@@ -301,7 +302,7 @@ impl DrivenVoice {
 
     fn set_gains(&mut self, g: &[f64]) {
         for (i, &gi) in g.iter().enumerate() {
-            self.w[i] = weight(self.opts.quantity, self.s[i], gi);
+            self.w[i] = phase_of(self.opts.phases.as_ref(), i) * weight(self.opts.quantity, self.s[i], gi);
         }
         self.gains_set = true;
         if let Some(t) = self.simd.as_mut() {

@@ -43,10 +43,10 @@ pub use contact::{
 pub use error::SynthError;
 pub use force::{DrivenStats, DrivenVoice, ForceSegment};
 pub use model::{SynthModel, MAX_SNAP_FRACTION};
-pub use modulation::{ConstantFactors, OutputModulation};
+pub use modulation::OutputModulation;
 pub use offline::{
-    auto_duration, render_strikes, render_strikes_modulated, RenderLength, Rendered, Strike, AUTO_DECAY_DB,
-    FADE_S, MAX_DURATION_S, MIN_AUTO_DURATION_S,
+    auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,
+    MIN_AUTO_DURATION_S,
 };
 pub use options::{
     check_sample_rate, classify_mode, Kernel, OutputGain, OutputQuantity, SkipReason, SynthOptions,

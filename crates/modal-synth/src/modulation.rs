@@ -41,34 +41,6 @@ pub trait OutputModulation: Send + Sync {
     fn factors(&self, time_s: f64, modes: &[usize], out: &mut [C64]);
 }
 
-/// Factors that do not change with time: a fixed complex gain per mode,
-/// `y = Σ_i Re(m_i W_i z_i)`. A listener at a fixed point of a body's frame
-/// hears each mode through its complex transfer `T_i`; the real gain `|T_i|`
-/// alone drops the phase, which decides whether two modes of one frequency
-/// (the degenerate pairs of every symmetric body) add or cancel there. The
-/// ramp of a constant factor is `ρ = 1` exactly, so the kernel runs
-/// unchanged.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ConstantFactors {
-    factors: Vec<C64>,
-}
-
-impl ConstantFactors {
-    /// One factor per bank mode (index = mode).
-    pub fn new(factors: Vec<C64>) -> ConstantFactors {
-        ConstantFactors { factors }
-    }
-}
-
-impl OutputModulation for ConstantFactors {
-    fn factors(&self, _time_s: f64, modes: &[usize], out: &mut [C64]) {
-        for (o, &i) in out.iter_mut().zip(modes) {
-            // A mode beyond the table (a caller's mistake) keeps its gain.
-            *o = self.factors.get(i).copied().unwrap_or(C64::new(1.0, 0.0));
-        }
-    }
-}
-
 /// A voice's modulation: the source and the factors at the end of the
 /// block last loaded.
 #[derive(Clone)]

@@ -9,12 +9,10 @@
 
 use crate::contact::DEFAULT_CONTACT_TIME_S;
 use crate::error::SynthError;
-use crate::modulation::OutputModulation;
 use crate::options::SynthOptions;
 use crate::surface::SurfacePoint;
 use crate::voice::{ModalVoice, VoiceStats, BLOCK};
 use modal_bank::ModeBank;
-use std::sync::Arc;
 
 /// Longest offline render \[s\] (bounds the output allocation).
 pub const MAX_DURATION_S: f64 = 3600.0;
@@ -89,23 +87,7 @@ pub fn render_strikes(
     opts: &SynthOptions,
     length: RenderLength,
 ) -> Result<Rendered, SynthError> {
-    render_strikes_modulated(bank, strikes, opts, length, None)
-}
-
-/// [`render_strikes`] with complex factors on the output weights
-/// ([`ModalVoice::set_modulation`]; for example a listener's per-mode
-/// transfer phase, [`crate::ConstantFactors`]).
-pub fn render_strikes_modulated(
-    bank: &ModeBank,
-    strikes: &[Strike],
-    opts: &SynthOptions,
-    length: RenderLength,
-    modulation: Option<Arc<dyn OutputModulation>>,
-) -> Result<Rendered, SynthError> {
     let mut voice = ModalVoice::new(bank, opts.clone())?;
-    if let Some(source) = modulation {
-        voice.set_modulation(source);
-    }
     let mut points = Vec::with_capacity(strikes.len());
     for s in strikes {
         points.push(voice.add_impulse(s.time_s, s.at, s.impulse_ns, s.contact_time_s)?);

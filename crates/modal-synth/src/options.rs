@@ -129,6 +129,13 @@ pub struct SynthOptions {
     pub budget: Option<usize>,
     /// Per-mode output gains.
     pub gain: OutputGain,
+    /// A constant complex factor `c_i` on each mode's output weight,
+    /// `y = Σ_i Re(c_i W_i z_i)`, one per bank mode (normally of modulus 1: a
+    /// phase). A listener's per-mode transfer has a phase as well as a level;
+    /// with the level alone, modes of one frequency (the pairs of symmetric
+    /// bodies) add or cancel by how the eigensolver happened to turn them.
+    /// `None`: every `c_i = 1`.
+    pub phases: Option<Vec<C64>>,
     /// Velocity or displacement output.
     pub quantity: OutputQuantity,
     /// Kernel choice.
@@ -146,11 +153,26 @@ impl Default for SynthOptions {
             cull_db: Some(-100.0),
             budget: None,
             gain: OutputGain::default(),
+            phases: None,
             quantity: OutputQuantity::Velocity,
             kernel: Kernel::Auto,
             parallel: true,
         }
     }
+}
+
+/// Checks that `phases`, when given, has one factor per mode of a bank of
+/// `modes` modes.
+pub(crate) fn check_phase_count(phases: Option<&Vec<C64>>, modes: usize) -> Result<(), SynthError> {
+    match phases {
+        Some(p) if p.len() != modes => Err(SynthError::GainCount { got: p.len(), expected: modes }),
+        _ => Ok(()),
+    }
+}
+
+/// Mode `i`'s factor of [`SynthOptions::phases`] (1 without them).
+pub(crate) fn phase_of(phases: Option<&Vec<C64>>, i: usize) -> C64 {
+    phases.map_or(C64::new(1.0, 0.0), |p| p[i])
 }
 
 /// Checks a sample rate: finite and within 8 kHz ..= 192 kHz.
@@ -180,6 +202,9 @@ impl SynthOptions {
             if let Some(&bad) = g.iter().find(|x| !x.is_finite()) {
                 return Err(SynthError::InvalidOption { name: "gain", value: bad });
             }
+        }
+        if let Some(bad) = self.phases.iter().flatten().find(|c| !c.is_finite()) {
+            return Err(SynthError::InvalidOption { name: "phase", value: bad.re + bad.im });
         }
         Ok(())
     }

@@ -26,7 +26,7 @@ use crate::contact::{half_sine_spectrum, MAX_CONTACT_TIME_S};
 use crate::error::SynthError;
 use crate::model::SynthModel;
 use crate::offline::Strike;
-use crate::options::{classify_mode, OutputGain, OutputQuantity, SynthOptions};
+use crate::options::{check_phase_count, classify_mode, phase_of, OutputGain, OutputQuantity, SynthOptions};
 use crate::surface::SurfacePoint;
 use crate::voice::MAX_TIME_S;
 use modal_bank::ModeBank;
@@ -92,6 +92,7 @@ impl ClosedForm {
         let points = strikes.iter().map(|s| check_strike(model, s)).collect::<Result<Vec<_>, _>>()?;
         let gains = resolve_gains(model, &opts.gain, points.first())?;
         let n = model.mode_count();
+        check_phase_count(opts.phases.as_ref(), n)?;
         let mut a = vec![0.0; n];
         let mut terms = Vec::new();
         for (strike, point) in strikes.iter().zip(&points) {
@@ -105,10 +106,12 @@ impl ClosedForm {
                     continue;
                 }
                 let z = half_sine_spectrum(s, strike.contact_time_s).scale(a[i] / s.im);
-                let k = match opts.quantity {
-                    OutputQuantity::Velocity => (s * z).scale(gains[i]),
-                    OutputQuantity::Displacement => z.scale(gains[i]),
-                };
+                // y = Re(c W z) = g Im(c s z) (velocity), g Im(c z) (displacement).
+                let k = phase_of(opts.phases.as_ref(), i)
+                    * match opts.quantity {
+                        OutputQuantity::Velocity => (s * z).scale(gains[i]),
+                        OutputQuantity::Displacement => z.scale(gains[i]),
+                    };
                 terms.push(Term { first, tc, decay: -s.re, omega: s.im, k });
             }
         }

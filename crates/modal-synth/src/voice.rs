@@ -52,7 +52,9 @@ use crate::error::SynthError;
 use crate::kernel::{self, LaneBuf, SimdPath, CHUNK, LANES, TILE};
 use crate::model::SynthModel;
 use crate::modulation::{Modulation, OutputModulation};
-use crate::options::{classify_mode, Kernel, OutputQuantity, SkipReason, SynthOptions};
+use crate::options::{
+    check_phase_count, classify_mode, phase_of, Kernel, OutputQuantity, SkipReason, SynthOptions,
+};
 use crate::surface::SurfacePoint;
 use modal_bank::ModeBank;
 use rayon::prelude::*;
@@ -307,6 +309,7 @@ impl ModalVoice {
             ramp: Vec::new(),
             opts,
         };
+        check_phase_count(voice.opts.phases.as_ref(), voice.model.mode_count())?;
         if let Some(g) = voice.model.initial_gains(&voice.opts.gain)? {
             voice.set_gains(&g);
         }
@@ -320,7 +323,8 @@ impl ModalVoice {
 
     fn set_gains(&mut self, g: &[f64]) {
         for (i, &gi) in g.iter().enumerate() {
-            self.modes.w[i] = weight(self.opts.quantity, self.modes.s[i], gi);
+            let phase = phase_of(self.opts.phases.as_ref(), i);
+            self.modes.w[i] = phase * weight(self.opts.quantity, self.modes.s[i], gi);
         }
         self.gains_set = true;
     }

@@ -12,9 +12,7 @@ mod common;
 
 use std::sync::Arc;
 
-use modal_synth::{
-    ConstantFactors, Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions, C64,
-};
+use modal_synth::{Kernel, ModalVoice, OutputGain, OutputModulation, OutputQuantity, SynthOptions, C64};
 
 /// `m_i(t) = c_i e^{(α_i + iΩ_i) t}`, or `cos(Ω_i t + φ_i)` (a dipole seen
 /// from a body spinning at Ω_i).
@@ -174,21 +172,28 @@ fn unit_factors_equal_the_unmodulated_voice() {
 }
 
 #[test]
-fn constant_factors_are_a_fixed_complex_gain_per_mode() {
+fn constant_phases_are_a_fixed_complex_gain_per_mode() {
     // What `strike` hears at a listener: `Re(c_i W_i z_i)` with each mode's
-    // transfer phase `c_i`, here against the per-sample reference.
+    // transfer phase `c_i` (`SynthOptions::phases`), against the per-sample
+    // reference, on both kernels.
     let bank = bank();
     let gains = vec![1.0, 0.5, 0.8, 0.3];
     let c = vec![C64::new(0.6, 0.8), C64::new(-1.0, 0.0), C64::new(0.0, -1.0), C64::new(0.28, -0.96)];
     let fixed = Source { kind: Kind::Exponential, params: c.iter().map(|&c| (c, 0.0, 0.0)).collect() };
     let want = reference(&bank, &gains, &fixed);
-    let mut v = ModalVoice::new(&bank, opts(gains, OutputQuantity::Velocity, Kernel::Auto)).unwrap();
-    v.set_modulation(Arc::new(ConstantFactors::new(c)));
-    strike(&mut v);
-    let mut got = vec![0.0f32; LEN];
-    v.render(&mut got, 0);
-    let (err, peak) = max_err(&got, &want);
-    assert!(peak > 1e-3 && err < 1e-5 * peak, "{err} vs peak {peak}");
+    let with = |phases: Vec<C64>, kernel| SynthOptions {
+        phases: Some(phases),
+        ..opts(gains.clone(), OutputQuantity::Velocity, kernel)
+    };
+    for kernel in [Kernel::Reference, Kernel::Auto] {
+        let (err, peak) = max_err(&render(&bank, with(c.clone(), kernel), None), &want);
+        assert!(peak > 1e-3 && err < 1e-5 * peak, "{kernel:?}: {err} vs peak {peak}");
+    }
+    // One finite factor per mode.
+    assert!(ModalVoice::new(&bank, with(c[..3].to_vec(), Kernel::Auto)).is_err());
+    let mut bad = c;
+    bad[1] = C64::new(f64::NAN, 0.0);
+    assert!(ModalVoice::new(&bank, with(bad, Kernel::Auto)).is_err());
 }
 
 /// Cost of the modulation against real gains: a 600-mode voice, 2 s at
