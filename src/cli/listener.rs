@@ -3,7 +3,7 @@
 //! Mode `i` vibrating with modal velocity `Re(V_i e^{−iωt})` radiates
 //! `Re(T_i(x) V_i e^{−iωt})` at the listener, `T_i(x)` the complex pressure
 //! [Pa] for unit modal velocity amplitude (`modal radiation`). In the
-//! synthesizer's convention (`e^{+iωt}`, [`modal_synth::modulation`]) that
+//! synthesizer's convention (`e^{+iωt}`, [`modal_synth::SynthOptions::phases`]) that
 //! is the real gain `g_i = |T_i| / FULL_SCALE_PA` (level, decay and culling
 //! use it) times the unit factor `conj(T_i e^{−ik_i r₀}) / |T_i|`. The phase
 //! matters: symmetric bodies (a bowl, a bell, a sphere) have pairs of modes
@@ -27,7 +27,10 @@
 //! 2. a boundary-element solve now (`--solve-radiation`),
 //! 3. the level estimate `render` uses without radiation (a pulsating
 //!    sphere with the object's area and the mode's RMS normal velocity,
-//!    `ρ₀c (a/r) (ka/√(1+(ka)²)) v_i`, no phase), with a warning.
+//!    `ρ₀c (a/r) (ka/√(1+(ka)²)) v_i`), with a warning. It has no phase;
+//!    modes of one frequency get [`modal_synth::degenerate_phases`], so a
+//!    pair is heard at its energy sum, not at a level set by how the
+//!    eigensolver turned it.
 
 use std::path::Path;
 
@@ -91,7 +94,7 @@ pub struct ListenerGains {
     /// One gain per bank mode: `|T_i| / FULL_SCALE_PA`.
     pub gains: Vec<f64>,
     /// One unit factor per bank mode, the transfer's phase (module doc);
-    /// `1` where no phase is known (the estimate).
+    /// for estimated modes, [`modal_synth::degenerate_phases`].
     pub phases: Vec<C64>,
     /// Where the transfer came from.
     pub source: TransferSource,
@@ -117,6 +120,7 @@ pub fn listener_gains(
     });
     if let Some(table) = table.filter(|_| !solve) {
         let estimate = estimate_gains(bank, x)?;
+        let direction_free = modal_synth::degenerate_phases(&bank.frequencies_hz);
         let mut heard = Heard::new(bank.mode_count());
         let mut missing = 0;
         let r = distance(x, table.centre_m);
@@ -139,6 +143,7 @@ pub fn listener_gains(
                 }
                 None => {
                     heard.gains[i] = estimate[i];
+                    heard.phases[i] = direction_free[i];
                     missing += 1;
                 }
             }
@@ -168,7 +173,7 @@ pub fn listener_gains(
         path.display()
     ));
     let gains = estimate_gains(bank, x)?;
-    let phases = vec![C64::new(1.0, 0.0); gains.len()];
+    let phases = modal_synth::degenerate_phases(&bank.frequencies_hz);
     Ok(ListenerGains { gains, phases, source: TransferSource::Estimate })
 }
 

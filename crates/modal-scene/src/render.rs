@@ -333,6 +333,14 @@ fn synthesize(
                 parallel: false,
                 ..SynthOptions::default()
             };
+            // An impact heard through a direction-free level hears modes of one
+            // frequency at their energy sum, the mean over directions, not at a level
+            // set by how the eigensolver turned them (a bowl's pair cancelled at some
+            // strike angles). The sustained-contact voice keeps the coherent sum: a
+            // contact running round a rim then swells and fades as a listener at one
+            // place would hear it (Euler's disk, tests/sustained_cli.rs), which a
+            // mean over directions cannot.
+            let direction_free = modal_synth::degenerate_phases(&banks[i].frequencies_hz);
             let failed = |e: modal_synth::SynthError| SceneError::Synthesis {
                 object: names(i),
                 message: e.to_string(),
@@ -343,11 +351,14 @@ fn synthesize(
                 Some(DrivenVoice::from_model(Arc::clone(model), opts.clone()).map_err(failed)?)
             };
             let voices = match transfer {
-                // One voice per listening point, each with its own direction.
+                // One voice per listening point, each with its own direction; the
+                // transfer's phase comes with it, so only estimated modes keep theirs.
                 Some(t) => ears
                     .iter()
                     .map(|&ear| {
-                        let mut v = ModalVoice::from_model(Arc::clone(model), opts.clone())?;
+                        let opts =
+                            SynthOptions { phases: Some(t.voice_phases(&direction_free)), ..opts.clone() };
+                        let mut v = ModalVoice::from_model(Arc::clone(model), opts)?;
                         v.set_modulation(Arc::new(EarTransfer::new(
                             Arc::clone(t),
                             Arc::clone(&paths[i]),
@@ -357,7 +368,10 @@ fn synthesize(
                     })
                     .collect::<Result<Vec<_>, _>>()
                     .map_err(failed)?,
-                None => vec![ModalVoice::from_model(Arc::clone(model), opts).map_err(failed)?],
+                None => {
+                    let opts = SynthOptions { phases: Some(direction_free), ..opts };
+                    vec![ModalVoice::from_model(Arc::clone(model), opts).map_err(failed)?]
+                }
             };
             // The transfer's gains are in Pa·m already; the estimate's are RMS velocities.
             let scale = match transfer {

@@ -174,6 +174,18 @@ impl BankTransfer {
         }
     }
 
+    /// The constant phases of a voice that hears this transfer: 1 for modes
+    /// with a table entry (their phase is in the modulation), and
+    /// `direction_free[i]` ([`modal_synth::degenerate_phases`]) for modes
+    /// heard through the estimate.
+    pub fn voice_phases(&self, direction_free: &[C64]) -> Vec<C64> {
+        self.modes
+            .iter()
+            .zip(direction_free)
+            .map(|(m, &p)| if m.is_some() { C64::new(1.0, 0.0) } else { p })
+            .collect()
+    }
+
     fn fallback(&self, i: usize) -> C64 {
         C64::new(if self.modes[i].is_some() { 0.0 } else { 1.0 }, 0.0)
     }

@@ -21,6 +21,7 @@
 
 mod complex;
 pub mod contact;
+pub mod degenerate;
 mod error;
 pub mod force;
 pub mod force_kernel;
@@ -40,6 +41,7 @@ pub use complex::C64;
 pub use contact::{
     effective_modulus, harmonic, hertz_contact_time, DEFAULT_CONTACT_TIME_S, MAX_CONTACT_TIME_S,
 };
+pub use degenerate::degenerate_phases;
 pub use error::SynthError;
 pub use force::{DrivenStats, DrivenVoice, ForceSegment};
 pub use model::{SynthModel, MAX_SNAP_FRACTION};
