@@ -87,4 +87,8 @@ fn impossible_materials() {
         args.extend(flags);
         modal(dir.path(), &args).fails_with(needle);
     }
+    // A bank written over its own mesh would destroy it.
+    modal(dir.path(), &["precompute", "good.msh", "-o", "good.msh", "--material", "steel"])
+        .fails_with("input file itself");
+    assert_eq!(std::fs::read_to_string(dir.path().join("good.msh")).unwrap(), GOOD_MSH);
 }

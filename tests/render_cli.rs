@@ -136,6 +136,8 @@ fn side_files_that_cannot_be_written_are_refused_before_the_render() {
         .fails_with("name the same file");
     render(&["--events", "missing/e.json"]).fails_with("does not exist");
     render(&["--spectrogram", "out"]).fails_with("is a directory");
+    render(&["--events", "s.toml"]).fails_with("input file itself");
+    assert_eq!(std::fs::read_to_string(dir.path().join("s.toml")).unwrap(), TWO_BLOCKS);
     let written = files_in(&dir.path().join("out"));
     assert!(written.is_empty(), "nothing written: {written:?}");
 }

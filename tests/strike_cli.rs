@@ -109,6 +109,10 @@ fn bad_strikes_fail_cleanly_without_output() {
         modal(dir.path(), &args).fails_with(needle);
         assert!(!dir.path().join("x.wav").exists(), "no partial WAV for {args:?}");
     }
+    // The output may not be the input: a WAV written over the bank destroyed it.
+    modal(dir.path(), &["strike", "bar.bank", "-o", "bar.bank"]).fails_with("input file itself");
+    modal(dir.path(), &["export", "bar.bank", "--vtk", "./bar.bank"]).fails_with("input file itself");
+    modal(dir.path(), &["info", "bar.bank"]).ok();
     // A bank with one flipped bit in its tensor data fails its checksum.
     let mut bytes = std::fs::read(dir.path().join("bar.bank")).unwrap();
     let last = bytes.len() - 7;

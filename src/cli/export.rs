@@ -122,6 +122,11 @@ fn gltf(
 }
 
 pub fn run(args: ExportArgs) -> Result<()> {
+    for (flag, path) in [("--vtk", &args.vtk), ("--gltf", &args.gltf), ("--faust", &args.faust)] {
+        if let Some(path) = path {
+            super::check_not_input(path, &args.bank, flag)?;
+        }
+    }
     let (bank, radiation) = load_bank_with_radiation(&args.bank)?;
     let mut report = serde_json::Map::new();
     report.insert("bank".into(), json!(args.bank.display().to_string()));

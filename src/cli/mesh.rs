@@ -21,6 +21,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
         MeshShape::Bowl { radius, thickness, common } => generate(Shape::Bowl { radius, thickness }, common),
         MeshShape::Corpus(args) => super::corpus::run(args),
         MeshShape::Tet { input, out, cell, scale, part, sheet_thickness, modes, json } => {
+            super::check_not_input(&out, &input, "-o")?;
             let (surface, mut report) = modal_tetra::read_surface(&input, scale, part.as_deref())
                 .with_context(|| format!("cannot read surface mesh {}", input.display()))?;
             if sheet_thickness.is_some() {

@@ -83,6 +83,35 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Refuses an output `out` (given as `flag`) that is the input file
+/// `input` itself (the same file, through any path, link or hard link): the
+/// write would replace what the command reads, a bank by a WAV, a mesh by a
+/// bank. Commands that update a file in place on purpose (`retune`,
+/// `radiation --store`) do not call this.
+pub fn check_not_input(out: &Path, input: &Path, flag: &str) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        !same_file(out, input),
+        "{flag} {} is the input file itself: writing there would destroy it; give the output its own name",
+        out.display()
+    );
+    Ok(())
+}
+
+/// Whether `a` and `b` name one existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else { return false };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
 /// Writes a file atomically: `write` fills a temporary file next to `path`,
 /// which is then renamed over `path`. On any error the temporary file is
 /// removed, so a failed or interrupted command never leaves a partial output.

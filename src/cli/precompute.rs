@@ -85,6 +85,7 @@ pub fn open_cache(dir: Option<&Path>, disabled: bool) -> Result<Option<BankCache
 }
 
 pub fn run(args: PrecomputeArgs) -> Result<()> {
+    super::check_not_input(&args.out, &args.mesh, "-o")?;
     // A glTF with a modal model is a bank; one without is geometry, meshed like an OBJ.
     if modal_export::gltf::is_gltf_path(&args.mesh)
         && modal_export::gltf::holds_modal_model(&args.mesh)

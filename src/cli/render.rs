@@ -587,6 +587,9 @@ fn check_outputs(out: &Path, args: &RenderArgs) -> Result<()> {
     let named: Vec<(&str, &Path)> = named.into_iter().filter_map(|(flag, p)| Some((flag, p?))).collect();
     for (k, (flag, path)) in named.iter().enumerate() {
         super::check_writable(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
+        if let Some(scene) = &args.scene {
+            super::check_not_input(path, scene, flag)?;
+        }
         for (other, earlier) in &named[..k] {
             anyhow::ensure!(
                 output_identity(path) != output_identity(earlier),
