@@ -243,6 +243,11 @@ fn points_inside_the_body_and_bad_air_are_clear_errors() {
         "{}",
         bad.stderr
     );
+    // Numbers no one types are shown as typed, not as 200 digits.
+    let huge = modal(dir.path(), &["radiation", "sphere.bank", "--air-density", "1e200"]).fails_with("1e200");
+    assert!(!huge.stderr.contains("00000000"), "{}", huge.stderr);
+    // Clusters beyond κ = 1 cost accuracy silently (0.8 dB in power at κ = 2): refused.
+    modal(dir.path(), &["radiation", "sphere.bank", "--cluster-kh", "2"]).fails_with("--cluster-kh");
     modal(dir.path(), &["radiation", "missing.bank", "--point", "1,0,0"]).fails_with("missing.bank");
     modal(dir.path(), &["radiation", "sphere.bank", "--point", "1,0,0", "--mode", "999"])
         .fails_with("does not exist");

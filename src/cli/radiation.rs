@@ -100,13 +100,23 @@ struct ModeJson {
     pressure_pa: Vec<[f64; 2]>,
 }
 
+/// Largest `--cluster-kh` accepted (see `run`).
+const MAX_CLUSTER_KH: f64 = 1.0;
+
 pub fn run(args: RadiationArgs) -> Result<()> {
     let started = Instant::now();
     let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let air = Air { density_kg_m3: args.air_density, sound_speed_m_s: args.sound_speed };
     air.validate()?;
     ensure!(args.max_freq > 0.0, "--max-freq must be positive");
-    ensure!(args.cluster_kh.is_finite() && args.cluster_kh > 0.0, "--cluster-kh must be finite and positive");
+    // Coarser clusters cost accuracy fast: on the test sphere a mode's power moves by
+    // 0.23 dB at κ = 0.6 and 0.65 dB at κ = 1 against the default 0.3, and by 0.8 dB
+    // beyond, with no warning; so κ stops at 1 (clusters of a sixth of a wavelength).
+    ensure!(
+        args.cluster_kh.is_finite() && args.cluster_kh > 0.0 && args.cluster_kh <= MAX_CLUSTER_KH,
+        "--cluster-kh must be above 0 and at most {MAX_CLUSTER_KH} (got {:e}): larger clusters lose accuracy",
+        args.cluster_kh
+    );
     let mesh = modal_radiation::modes::boundary_mesh(&bank).context("the bank's surface cannot be used")?;
     check_field_points(&bank, &mesh, &args.point).context("--point")?;
     let audible = |i: usize| modal_radiation::modes::is_audible(&bank, i, args.max_freq);
