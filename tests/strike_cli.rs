@@ -96,6 +96,16 @@ fn bad_strikes_fail_cleanly_without_output() {
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "-1", "-o", "x.wav"], "duration"),
         (vec!["strike", "bar.bank", at[0], at[1], "--time", "1", "--time", "2", "-o", "x.wav"], "--time"),
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "0", "-o", "x.wav"], "above 0 s"),
+        (
+            vec!["strike", "bar.bank", at[0], at[1], "--contact-time", "-1", "-o", "x.wav"],
+            "contact time -1 s",
+        ),
+        (
+            vec!["strike", "bar.bank", at[0], at[1], "--contact-time", "1e300", "-o", "x.wav"],
+            "contact time 1e300 s",
+        ),
+        (vec!["strike", "bar.bank", at[0], at[1], "--hertz", "1e300,1e-300", "-o", "x.wav"], "--hertz needs"),
+        (vec!["strike", "bar.bank", at[0], at[1], "--impulse", "1e300", "-o", "x.wav"], "-1e300]"),
         // Not blamed on a weak impulse: no strike falls inside the file.
         (
             vec!["strike", "bar.bank", at[0], at[1], "--time", "2", "--duration", "1", "-o", "x.wav"],

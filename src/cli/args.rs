@@ -356,7 +356,7 @@ pub struct StrikeArgs {
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub time: Vec<f64>,
     /// Contact time τ [s] of the half-sine force.
-    #[arg(long, value_name = "S", conflicts_with = "hertz")]
+    #[arg(long, value_name = "S", conflicts_with = "hertz", allow_negative_numbers = true)]
     pub contact_time: Option<f64>,
     /// Hertz contact of a sphere of MASS_KG and RADIUS_M of the bank's material, striking at the speed
     /// --impulse / MASS_KG (the impulse it delivers when it stops; 1 m/s for a zero impulse).

@@ -25,6 +25,9 @@ pub const DEFAULT_IMPULSE_NS: f64 = 0.01;
 pub const AUTO_DURATION_CAP_S: f64 = 30.0;
 /// Level of `--normalize`: peak at −1 dBFS.
 const NORMALIZED_PEAK: f64 = 0.891;
+/// Heaviest and largest `--hertz` striker accepted [kg, m] (a wrecking ball).
+const MAX_STRIKER_KG: f64 = 1e4;
+const MAX_STRIKER_M: f64 = 10.0;
 /// Approach speed [m/s] assumed by `--hertz` (t_c ∝ v^{−1/5}, so it matters little).
 const HERTZ_SPEED_M_S: f64 = 1.0;
 
@@ -89,13 +92,27 @@ fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f
     let Some([mass_kg, radius_m]) = args.hertz else {
         return Ok(DEFAULT_CONTACT_TIME_S);
     };
-    ensure!(mass_kg > 0.0 && radius_m > 0.0, "--hertz needs a positive mass and radius");
+    ensure!(
+        (f64::MIN_POSITIVE..=MAX_STRIKER_KG).contains(&mass_kg) && (f64::MIN_POSITIVE..=MAX_STRIKER_M).contains(&radius_m),
+        "--hertz needs a striker of positive mass up to {MAX_STRIKER_KG} kg and radius up to {MAX_STRIKER_M} m"
+    );
     // A striker of the bank's own material hitting the (locally flat) surface.
     let m = &bank.material;
     let e_star = contact::effective_modulus(m.youngs_pa, m.poisson, m.youngs_pa, m.poisson);
     let m_eff = contact::harmonic(mass_kg, bank.mass.mass_kg);
     let speed = if impulse_ns > 0.0 { impulse_ns / mass_kg } else { HERTZ_SPEED_M_S };
-    contact::hertz_contact_time(m_eff, radius_m, e_star, speed).context("invalid --hertz parameters")
+    let tau =
+        contact::hertz_contact_time(m_eff, radius_m, e_star, speed).context("invalid --hertz parameters")?;
+    let max = contact::MAX_CONTACT_TIME_S;
+    ensure!(
+        tau.is_finite() && tau <= max,
+        "--hertz {},{} gives a contact time of {} s, beyond the {max} s a strike may last (a striker this heavy \
+         and slow pushes rather than strikes)",
+        modal_mesh::readable(mass_kg),
+        modal_mesh::readable(radius_m),
+        modal_mesh::readable(tau)
+    );
+    Ok(tau)
 }
 
 pub fn run(args: StrikeArgs) -> Result<()> {

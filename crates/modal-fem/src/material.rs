@@ -212,10 +212,7 @@ impl Material {
     /// β ≥ 0, all finite. The error names the offending field and value.
     pub fn validate(&self) -> Result<(), MaterialError> {
         let bad = |what: &str, v: f64, rule: &str| {
-            // 1e-300, not three hundred zeros.
-            let v =
-                if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
-            Err(MaterialError::Invalid(format!("{what} = {v} ({rule})")))
+            Err(MaterialError::Invalid(format!("{what} = {} ({rule})", modal_mesh::readable(v))))
         };
         let fields = [
             ("Young's modulus E [Pa]", self.youngs_pa),

@@ -55,7 +55,7 @@ pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;
 pub use types::*;
 pub use units::{
-    bounding_box, bounding_diagonal, scale_refusal, unit_warning, unstated_size_refusal,
+    bounding_box, bounding_diagonal, readable, scale_refusal, unit_warning, unstated_size_refusal,
     LARGEST_PLAIN_DIAGONAL_M, LARGEST_UNREMARKED_DIAGONAL_M, SCALE_RANGE, SMALLEST_PLAIN_DIAGONAL_M,
 };
 pub use validate::{

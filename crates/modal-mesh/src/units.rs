@@ -23,6 +23,17 @@ pub const LARGEST_UNREMARKED_DIAGONAL_M: f64 = 2.5;
 /// rings above any audio band.
 pub const SMALLEST_PLAIN_DIAGONAL_M: f64 = 0.005;
 
+/// `x` as one would type it, for quoting a user's value back in a message:
+/// `1.21`, `343`, `0.5`, but `1e300` and `1e-300` rather than hundreds of
+/// digits (Rust's `{}` writes every digit of an f64).
+pub fn readable(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// The range of scale factors accepted, stated or not: a scale converts a
 /// file's unit to metres, from micrometres (10⁻⁶) to kilometres (10³) and
 /// a margin beyond. Outside it no conversion is meant (`--scale 1e300`
@@ -103,6 +114,16 @@ pub fn unstated_size_refusal(diagonal_m: f64) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn readable_numbers_are_short() {
+        assert_eq!(readable(1e300), "1e300");
+        assert_eq!(readable(-1e-300), "-1e-300");
+        assert_eq!(readable(343.0), "343");
+        assert_eq!(readable(0.0), "0");
+        assert_eq!(readable(f64::NAN), "NaN");
+        assert_eq!(readable(2.5e6), "2.5e6");
+    }
 
     #[test]
     fn only_unit_conversions_are_scales() {

@@ -35,8 +35,8 @@ pub enum RadiationError {
     #[error(
         "air density {} kg/m³ and sound speed {} m/s must lie within {} – {} kg/m³ and {} – {} m/s \
          (gases and liquids)",
-        readable(*density),
-        readable(*speed),
+        modal_mesh::readable(*density),
+        modal_mesh::readable(*speed),
         crate::bem::DENSITY_RANGE_KG_M3.0,
         crate::bem::DENSITY_RANGE_KG_M3.1,
         crate::bem::SOUND_SPEED_RANGE_M_S.0,
@@ -144,14 +144,5 @@ fn metres(x: f64) -> String {
         "0".into()
     } else {
         format!("{x:.2e}")
-    }
-}
-
-/// `x` as written by hand: `1.21`, `343`, but `1e300` rather than 301 digits.
-fn readable(x: f64) -> String {
-    if x != 0.0 && x.is_finite() && !(1e-3..1e6).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
     }
 }

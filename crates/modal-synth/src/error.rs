@@ -1,21 +1,23 @@
 //! Typed errors of the synthesizer; each message is one line naming the bad value.
 
+use modal_mesh::readable;
+
 /// Everything that can go wrong when striking a bank or writing audio.
 #[derive(Debug, thiserror::Error)]
 pub enum SynthError {
     /// Sample rate not finite or outside 8 kHz ..= 192 kHz.
-    #[error("sample rate {0} Hz is outside 8000..=192000 Hz")]
+    #[error("sample rate {} Hz is outside 8000..=192000 Hz", readable(*.0))]
     SampleRate(f64),
     /// An event time that is NaN, infinite or negative.
-    #[error("invalid time {0} s for {1} (must be finite and >= 0)")]
+    #[error("invalid time {} s for {} (must be finite and >= 0)", readable(*.0), .1)]
     InvalidTime(f64, &'static str),
     /// An impulse vector with a NaN or infinite component.
-    #[error("impulse [{}, {}, {}] N·s is not finite", .0[0], .0[1], .0[2])]
+    #[error("impulse [{}, {}, {}] N·s is not finite", readable(.0[0]), readable(.0[1]), readable(.0[2]))]
     InvalidImpulse([f64; 3]),
     /// An impulse whose response could exceed the f32 output range.
     #[error(
         "impulse [{}, {}, {}] N·s would drive the output up to {bound:e} (limit {limit:e} output units, f32 range)",
-        impulse[0], impulse[1], impulse[2]
+        readable(impulse[0]), readable(impulse[1]), readable(impulse[2])
     )]
     OutputOverflow {
         /// The offending impulse [N·s].
@@ -26,13 +28,13 @@ pub enum SynthError {
         limit: f64,
     },
     /// A force knot with a NaN, infinite or absurdly large component.
-    #[error("force [{}, {}, {}] N is not finite or exceeds 1e9 N", .0[0], .0[1], .0[2])]
+    #[error("force [{}, {}, {}] N is not finite or exceeds 1e9 N", readable(.0[0]), readable(.0[1]), readable(.0[2]))]
     InvalidForce([f64; 3]),
     /// A contact time that is NaN, negative or longer than the allowed maximum.
-    #[error("contact time {0} s must be finite and within 0..={max} s", max = crate::contact::MAX_CONTACT_TIME_S)]
+    #[error("contact time {} s must be finite and within 0..={max} s", readable(*.0), max = crate::contact::MAX_CONTACT_TIME_S)]
     InvalidContactTime(f64),
     /// A query point with a NaN or infinite coordinate.
-    #[error("point [{}, {}, {}] m is not finite", .0[0], .0[1], .0[2])]
+    #[error("point [{}, {}, {}] m is not finite", readable(.0[0]), readable(.0[1]), readable(.0[2]))]
     InvalidPoint([f64; 3]),
     /// A query point farther from the surface than 10 % of the bounding-box diagonal.
     #[error(
@@ -62,7 +64,7 @@ pub enum SynthError {
         expected: usize,
     },
     /// A non-finite option value (cull threshold, gain, duration...).
-    #[error("invalid option {name} = {value}")]
+    #[error("invalid option {name} = {}", readable(*value))]
     InvalidOption {
         /// Option name.
         name: &'static str,
