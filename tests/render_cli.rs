@@ -93,6 +93,7 @@ fn bad_scenes_name_the_field_and_write_nothing() {
     let dir = temp_dir();
     let cases = [
         (TWO_BLOCKS.replace("duration = 0.6", "duration = -1"), "duration"),
+        (TWO_BLOCKS.replace("duration = 0.6", "duration = 1e-9"), "at least 0.001 s, got 1e-9"),
         (TWO_BLOCKS.replacen("material = \"steel\"", "material = \"unobtainium\"", 1), "unobtainium"),
         (TWO_BLOCKS.replacen("position = [-0.1, 0.05, 0.0]", "position = [-0.1, nan, 0.0]", 1), "position"),
         (TWO_BLOCKS.replacen("position = [-0.1, 0.05, 0.0]", "position = [-0.1, 0.0, 0.0]", 1), "ground"),

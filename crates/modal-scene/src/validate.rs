@@ -19,6 +19,9 @@ pub const MAX_SPEED_M_S: f64 = 1000.0;
 /// Fastest accepted initial spin of an object [rad/s].
 pub const MAX_ANGULAR_SPEED_RAD_S: f64 = 10_000.0;
 
+/// Shortest accepted scene [s]: one millisecond (a shorter one holds no sound).
+pub const MIN_DURATION_S: f64 = 1e-3;
+
 pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
     positive("duration", scene.duration_s)?;
     if scene.duration_s > MAX_DURATION_S {
@@ -31,6 +34,13 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
         return Err(SceneError::invalid(
             "sample_rate",
             format!("must lie in 8000..=192000 Hz, got {}", scene.sample_rate_hz),
+        ));
+    }
+    if scene.duration_s < MIN_DURATION_S {
+        // 1e-9 s wrote a WAV of no frame with exit 0.
+        return Err(SceneError::invalid(
+            "duration",
+            format!("at least {MIN_DURATION_S} s, got {}", modal_mesh::readable(scene.duration_s)),
         ));
     }
     positive("physics_rate", scene.physics_rate_hz)?;
