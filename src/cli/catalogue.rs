@@ -53,8 +53,7 @@ pub fn run(command: CatalogueCommand) -> Result<()> {
 }
 
 fn merge(args: MergeArgs) -> Result<()> {
-    let out_dir =
-        args.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let out_dir = super::directory_of(&args.out);
     std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let (merged, report) = modal_batch::merge(&args.inputs, out_dir)?;
     if !merged.complete && !args.partial {

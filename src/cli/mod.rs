@@ -69,7 +69,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
 /// file is created there and removed). So a solve of minutes never ends in
 /// "cannot write".
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = directory_of(path);
     anyhow::ensure!(!path.is_dir(), "{} is a directory", path.display());
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
     anyhow::ensure!(dir.is_dir(), "directory {} does not exist", dir.display());
@@ -81,6 +81,11 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot write in {}: {e}", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// The directory a file `path` is in (`.` for a bare name).
+pub fn directory_of(path: &Path) -> &Path {
+    path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."))
 }
 
 /// Refuses an output `out` (given as `flag`) that is the input file
@@ -116,7 +121,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 /// which is then renamed over `path`. On any error the temporary file is
 /// removed, so a failed or interrupted command never leaves a partial output.
 pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = directory_of(path);
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
     let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
     interrupt::guarded(|| {

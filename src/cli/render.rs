@@ -603,7 +603,7 @@ fn check_outputs(out: &Path, args: &RenderArgs) -> Result<()> {
 
 /// `path` with its directory resolved, to compare outputs.
 fn output_identity(path: &Path) -> PathBuf {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = super::directory_of(path);
     let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
     dir.join(path.file_name().unwrap_or_default())
 }

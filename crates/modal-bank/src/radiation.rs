@@ -75,15 +75,8 @@ impl RadiationTable {
         };
         let points = &bank.surface.positions;
         if !points.is_empty() {
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for p in points {
-                for q in 0..3 {
-                    lo[q] = lo[q].min(p[q]);
-                    hi[q] = hi[q].max(p[q]);
-                }
-            }
-            let diagonal = (0..3).map(|q| (hi[q] - lo[q]).powi(2)).sum::<f64>().sqrt();
-            let slack = 1e-6 * diagonal;
+            let (lo, hi) = modal_mesh::bounding_box(points.iter().copied());
+            let slack = 1e-6 * modal_mesh::bounding_diagonal(points);
             for q in 0..3 {
                 let c = self.centre_m[q];
                 if c < lo[q] - slack || c > hi[q] + slack {
