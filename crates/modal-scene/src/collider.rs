@@ -1,6 +1,13 @@
 //! Collision shapes of bodies, built from a bank's surface (mesh frame).
 //!
-//! - fixed bodies: the surface triangle mesh;
+//! - fixed bodies: the surface triangle mesh, unless the surface is convex
+//!   (its hull's volume within [`FIXED_CONVEX_RATIO`] of the mesh's volume):
+//!   then the same hull or exact ball as a dynamic body. A body resting
+//!   exactly on a triangle mesh whose faces it shares (a bar on a fixed bar,
+//!   a block on a fixed block of the same footprint) gets contacts from the
+//!   mesh's side triangles through the shared edges: in rapier 0.36 a bar
+//!   turned 0.1–2° on a fixed bar was thrown off at up to 8 m/s, where the
+//!   same bar on the fixed bar's hull stays put (`tests/stacks.rs`);
 //! - dynamic bodies, `collider = "hull"`: the convex hull of the surface nodes,
 //!   reduced to at most [`MAX_HULL_VERTICES`] vertices: the points extreme
 //!   along as many directions spread over the sphere (vertices of the full
@@ -108,6 +115,29 @@ impl ShapeCache {
         };
         self.shapes.push((key, kind, shape.clone()));
         Ok(shape)
+    }
+}
+
+/// A fixed body is convex, and collides as its hull, when the hull's volume
+/// is at most this many times the mesh's own volume (module doc).
+pub const FIXED_CONVEX_RATIO: f64 = 1.01;
+
+impl ShapeCache {
+    /// The collision shape of a fixed body with `bank`: its exact ball or
+    /// hull when the surface is convex (within [`FIXED_CONVEX_RATIO`]), else
+    /// `None` (the caller builds the surface triangle mesh).
+    pub fn fixed_convex_shape(
+        &mut self,
+        bank: &Arc<ModeBank>,
+        path: &str,
+    ) -> Result<Option<SharedShape>, SceneError> {
+        let shape = self.dynamic_shape(bank, ColliderKind::Hull, path)?;
+        if shape.as_compound().is_some() {
+            return Ok(Some(shape)); // the exact ball
+        }
+        let mesh_volume = bank.mass.mass_kg / bank.material.density_kg_m3;
+        let hull_volume = shape.mass_properties(1.0).mass() as f64;
+        Ok((hull_volume <= FIXED_CONVEX_RATIO * mesh_volume).then_some(shape))
     }
 }
 

@@ -36,6 +36,18 @@
 //! thinnest extent) contacts can be missed: a 1 cm ball dropped into a
 //! decomposed (dynamic) bowl fell through its bottom at 5 and 10 mm.
 //!
+//! **Bodies set touching.** parry's contact query between two convex hulls
+//! is unreliable when they start within a few µm of each other with faces
+//! flush (GJK at a degenerate simplex): a bar set on a bar got a sideways or
+//! inverted normal (separation −4 cm) on the first step and was pushed into
+//! the bar below, then thrown out at metres per second. So before the first
+//! step each dynamic body closer than [`START_GAP_M`] to a body below it is
+//! lifted to that gap ([`open_start_gaps`]); the first query then sees two
+//! separated shapes, and the body settles onto the other through rapier's
+//! speculative contact, without an impact (`tests/stacks.rs`). Fixed convex
+//! bodies collide as their hull, not their triangle mesh, for the same
+//! reason ([`crate::collider`]).
+//!
 //! Stepping is single-threaded with a fixed `dt = 1/physics_rate` and the
 //! Coulomb friction model (one friction constraint per contact point), so the
 //! per-point friction impulse is meaningful and runs are bit-reproducible.
@@ -254,6 +266,49 @@ fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scen
     Ok(())
 }
 
+/// A dynamic body set closer than this to a body below it (touching, or
+/// overlapping within [`START_OVERLAP_TOLERANCE_M`]) is lifted to this gap
+/// before the first step [m] (module doc, "Bodies set touching").
+pub const START_GAP_M: f64 = 5e-5;
+
+/// Lifts each dynamic body that starts within [`START_GAP_M`] of a body whose
+/// centre lies lower (against gravity; +y without gravity) to that gap,
+/// lowest bodies first, so a stack opens from the bottom up. Colliders sit at
+/// their body's pose (no offset), so the body's pose is the collider's.
+fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], gravity: [f64; 3]) {
+    let g = dot(gravity, gravity).sqrt();
+    let up = if g > 0.0 { gravity.map(|x| -x / g) } else { [0.0, 1.0, 0.0] };
+    let height = |w: &PhysicsWorld, h: RigidBodyHandle| dot(d3(w.bodies[h].center_of_mass()), up);
+    let mut order: Vec<usize> = (0..bodies.len()).filter(|&i| world.bodies[bodies[i]].is_dynamic()).collect();
+    order.sort_by(|&a, &b| height(world, bodies[a]).total_cmp(&height(world, bodies[b])));
+    for i in order {
+        let own = height(world, bodies[i]);
+        let mut nearest = f64::INFINITY;
+        for (j, other) in bodies.iter().enumerate() {
+            if j == i || height(world, *other) >= own {
+                continue;
+            }
+            for a in world.bodies[bodies[i]].colliders() {
+                for b in world.bodies[*other].colliders() {
+                    let (a, b) = (&world.colliders[*a], &world.colliders[*b]);
+                    let (pa, pb) = (world.bodies[bodies[i]].position(), world.bodies[*other].position());
+                    if let Ok(Some(c)) =
+                        rapier3d::parry::query::contact(pa, a.shape(), pb, b.shape(), START_GAP_M as f32)
+                    {
+                        nearest = nearest.min(c.dist as f64);
+                    }
+                }
+            }
+        }
+        if nearest < START_GAP_M {
+            let lift = START_GAP_M - nearest;
+            let body = &mut world.bodies[bodies[i]];
+            let t = d3(body.translation());
+            body.set_translation(v3([t[0] + lift * up[0], t[1] + lift * up[1], t[2] + lift * up[2]]), false);
+        }
+    }
+}
+
 impl World {
     /// Builds bodies and colliders for all objects and the ground.
     pub fn new(scene: &Scene, banks: &[Arc<ModeBank>]) -> Result<World, SceneError> {
@@ -299,6 +354,7 @@ impl World {
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
         check_overlaps(&world, &bodies, scene)?;
+        open_start_gaps(&mut world, &bodies, scene.gravity_m_s2);
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
         let fixed_com =
             scene.objects.iter().map(|o| (o.body != BodyKind::Dynamic).then_some(o.position_m)).collect();
@@ -543,6 +599,8 @@ fn add_object(
     };
     let collider = if dynamic {
         ColliderBuilder::new(shapes.dynamic_shape(bank, o.collider, &path)?)
+    } else if let Some(convex) = shapes.fixed_convex_shape(bank, &path)? {
+        ColliderBuilder::new(convex)
     } else {
         // Internal edges fixed: a ball rolling across a triangle boundary of a
         // flat face must not hit the edge (a ghost collision, heard as a tick).
