@@ -51,7 +51,7 @@ pub use modal_synth::WavFormat;
 pub use output::{
     write_events_json, write_spectrogram_png, write_wav, SPECTROGRAM_RANGE_DB, SPECTROGRAM_WINDOW,
 };
-pub use physics::{ContactSide, ROLLING_LOAD_CAP, SLEEP_AFTER_S, START_OVERLAP_TOLERANCE_M};
+pub use physics::{ContactSide, ROLLING_LOAD_CAP, SLEEP_AFTER_S, SLEEP_SPEED_M_S, START_OVERLAP_TOLERANCE_M};
 pub use provider::{
     BankCompletion, BankProvider, BankRequest, InMemoryProvider, ProvidedBank, ProviderError,
 };

@@ -21,7 +21,9 @@
 //! [`ROLLING_LOAD_CAP`] `· m·|g|·dt` (the couple models the resting load, not
 //! impacts): the clamp stops the rotation instead of reversing it. Free flight is unaffected (no
 //! contact, no couple). Bodies then come to rest and fall asleep under
-//! rapier's sleep rule (every point slower than 0.1 m/s), after
+//! rapier's sleep rule, every point slower than [`SLEEP_SPEED_M_S`] (rapier's
+//! own 0.1 m/s, sized for metre-scale bodies, froze a block sliding at 9 cm/s
+//! on ice after 1.8 cm, and a bar drifting at 5 cm/s in mid-air), after
 //! [`SLEEP_AFTER_S`] instead of rapier's 0.5 s: a bouncing or rocking body
 //! passes below the threshold only for a few milliseconds at its turning
 //! points, and a sleeping body is woken by anything that touches it.
@@ -64,9 +66,13 @@ use crate::roughness::{object_surface, resolve_surface, SurfaceFinish};
 use crate::spec::{BodyKind, Scene};
 use crate::SceneError;
 
-/// A dynamic body whose every point moves slower than rapier's threshold
-/// (0.1 m/s) for this long falls asleep [s] (rapier's default is 0.5 s).
+/// A dynamic body whose every point moves slower than [`SLEEP_SPEED_M_S`]
+/// for this long falls asleep [s] (rapier's default is 0.5 s).
 pub const SLEEP_AFTER_S: f64 = 0.2;
+
+/// Speed below which every point of a body must stay for [`SLEEP_AFTER_S`]
+/// before it sleeps [m/s] (module doc; rapier's default is 0.1 m/s).
+pub const SLEEP_SPEED_M_S: f64 = 0.01;
 
 /// The normal impulse entering the rolling-resistance couple is capped at
 /// this many times the body's weight impulse `m·|g|·dt`: the couple models
@@ -619,7 +625,12 @@ fn add_object(
         .restitution_combine_rule(CoefficientCombineRule::Average)
         .user_data(i as u128);
     let handle = world.bodies.insert(builder);
-    world.bodies[handle].activation_mut().time_until_sleep = SLEEP_AFTER_S as f32;
+    let activation = world.bodies[handle].activation_mut();
+    activation.time_until_sleep = SLEEP_AFTER_S as f32;
+    // rapier compares half the farthest point's displacement per step with
+    // this threshold × dt, so the point speed limit is twice the threshold.
+    activation.normalized_linear_threshold =
+        (0.5 * SLEEP_SPEED_M_S) as f32 / world.integration_parameters.length_unit;
     world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
     let side = ContactSide {
         object: Some(i),

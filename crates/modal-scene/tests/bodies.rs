@@ -152,3 +152,30 @@ angular_velocity = [0.0, 2.0, 1.0]
     eprintln!("without rolling resistance: {} steps", out.report.physics_steps);
     assert!(out.report.physics_steps > steps + 500, "{} steps", out.report.physics_steps);
 }
+
+#[test]
+fn a_slow_body_keeps_moving_until_it_is_at_rest() {
+    // A block sliding at 5 cm/s on frictionless ice must not be put to sleep
+    // as if it were at rest (rapier's 0.1 m/s rule stopped it after 1 cm).
+    let text = r#"
+duration = 1.0
+sample_rate = 16000
+[listener]
+channels = "mono"
+[ground]
+friction = 0.0
+[[objects]]
+name = "block"
+mesh = { generate = "box", size = [0.12, 0.03, 0.06] }
+material = "wood"
+position = [0.0, 0.015, 0.0]
+linear_velocity = [0.05, 0.0, 0.0]
+friction = 0.0
+"#;
+    let scene = Scene::from_toml_str(text, Path::new(".")).expect("scene");
+    let mut p = InMemoryProvider::new();
+    p.insert("box", common::block([0.12, 0.03, 0.06], &[3000.0]));
+    let out = render(&scene, &mut p, &RenderOptions::default()).expect("render");
+    let x = out.report.objects[0].final_position_m[0];
+    assert!((x - 0.05).abs() < 2e-3, "the block ends at x = {x} m, not 0.05 m");
+}
