@@ -138,6 +138,8 @@ fn side_files_that_cannot_be_written_are_refused_before_the_render() {
     render(&["--events", "missing/e.json"]).fails_with("does not exist");
     render(&["--spectrogram", "out"]).fails_with("is a directory");
     render(&["--events", "s.toml"]).fails_with("input file itself");
+    // Refused whether or not a bank is to be solved (a cached scene took 0).
+    render(&["--threads", "0"]).fails_with("--threads must be between 1 and 1024, got 0");
     assert_eq!(std::fs::read_to_string(dir.path().join("s.toml")).unwrap(), TWO_BLOCKS);
     let written = files_in(&dir.path().join("out"));
     assert!(written.is_empty(), "nothing written: {written:?}");

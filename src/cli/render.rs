@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use modal_bank::{BankCache, CacheKey, ModeBank, RadiationTable};
 use modal_fem::Material;
 use modal_mesh::generate::ElementSizes;
@@ -357,6 +357,13 @@ impl PipelineProvider<'_> {
     fn served_from_cache(&mut self, bank: &ModeBank, what: &str) {
         let warning = modal_precompute::residual_floor_warning(bank);
         self.warnings.extend(warning.map(|w| format!("{what}: {w}")));
+        if bank.mode_count() == 0 {
+            // Said on every render, not only the one that solved the bank.
+            self.warnings.push(format!(
+                "{what}: no mode below the scene's sample_rate / 2: the bank is silent (a small or stiff \
+                 object rings higher)"
+            ));
+        }
         self.cached += 1;
     }
 
@@ -431,6 +438,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Some(RadiationChoice::Estimate) => scene.listener.radiation = modal_scene::Radiation::Estimate,
         Some(RadiationChoice::Transfer) => scene.listener.radiation = modal_scene::Radiation::Transfer,
         None => {}
+    }
+    if let Some(n) = args.threads.filter(|n| !(1..=modal_precompute::MAX_THREADS).contains(n)) {
+        // Checked here, not only when a bank is solved: a cached scene accepted 0.
+        bail!("--threads must be between 1 and {}, got {n}", modal_precompute::MAX_THREADS);
     }
     let out = args.out.clone().unwrap_or(default_out);
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
