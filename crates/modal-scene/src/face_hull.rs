@@ -50,6 +50,20 @@ impl FaceHull {
         FaceHull { poly }
     }
 
+    /// Distance from the local point `p` to the nearest face plane, positive
+    /// inside (then the depth of `p` in the solid), negative outside.
+    pub fn depth_of(&self, p: Vector) -> Real {
+        let poly = &self.poly;
+        let corners = poly.vertices_adj_to_face();
+        poly.faces()
+            .iter()
+            .map(|face| {
+                let corner = poly.points()[corners[face.first_vertex_or_edge as usize] as usize];
+                face.normal.dot(corner - p)
+            })
+            .fold(Real::INFINITY, Real::min)
+    }
+
     /// The wrapped polyhedron.
     #[cfg_attr(not(test), allow(dead_code))]
     pub fn polyhedron(&self) -> &ConvexPolyhedron {

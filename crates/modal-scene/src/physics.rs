@@ -61,6 +61,7 @@ use modal_fem::Material;
 use rapier3d::prelude::*;
 
 use crate::collider::{surface_points, surface_triangles, ShapeCache};
+use crate::face_hull::FaceHull;
 use crate::material::{plane_strain_modulus, resolve_material};
 use crate::roughness::{object_surface, resolve_surface, SurfaceFinish};
 use crate::spec::{BodyKind, Scene};
@@ -253,8 +254,20 @@ fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scen
                 }
                 let contact =
                     rapier3d::parry::query::contact(a.position(), a.shape(), b.position(), b.shape(), 0.0);
-                let Ok(Some(contact)) = contact else { continue };
-                if -contact.dist as f64 > START_OVERLAP_TOLERANCE_M {
+                let depth = match contact {
+                    Ok(Some(contact)) => -contact.dist as f64,
+                    _ => 0.0,
+                };
+                // The query misreads shapes whose flat faces coincide (an exact
+                // duplicate, a "+" of bars through each other: depth 0): a centre
+                // of mass inside the other collider is an overlap whatever it says.
+                let centres = [(&scene.objects[i].position_m, a, b), (&scene.objects[j].position_m, b, a)];
+                let depth = centres
+                    .iter()
+                    .filter(|(_, own, _)| is_one_convex_piece(own))
+                    .map(|(c, _, other)| centre_depth(c, other))
+                    .fold(depth, f64::max);
+                if depth > START_OVERLAP_TOLERANCE_M {
                     return Err(SceneError::invalid(
                         format!("objects[{j}].position"),
                         format!(
@@ -262,7 +275,7 @@ fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scen
                              as its convex hull unless collider = \"decomposition\"): move them apart",
                             scene.object_name(j),
                             scene.object_name(i),
-                            -contact.dist
+                            depth
                         ),
                     ));
                 }
@@ -313,6 +326,43 @@ fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], gravity
             body.set_translation(v3([t[0] + lift * up[0], t[1] + lift * up[1], t[2] + lift * up[2]]), false);
         }
     }
+}
+
+/// How deep the point `p` (world frame) lies inside `collider`'s solid [m], 0
+/// outside. Convex parts are measured against their faces: parry's projection
+/// of a point inside a polyhedron returns the point itself.
+fn centre_depth(p: &[f64; 3], collider: &Collider) -> f64 {
+    let local = collider.position().inverse_transform_point(v3(*p));
+    let shape = collider.shape();
+    if let Some(hull) = shape.as_shape::<FaceHull>() {
+        return hull.depth_of(local).max(0.0) as f64;
+    }
+    if let Some(compound) = shape.as_compound() {
+        let part_depth = |(pose, part): &(Pose, SharedShape)| {
+            let q = pose.inverse_transform_point(local);
+            if let Some(hull) = part.as_shape::<FaceHull>() {
+                hull.depth_of(q)
+            } else if let Some(ball) = part.as_ball() {
+                ball.radius - q.length()
+            } else {
+                0.0
+            }
+        };
+        return compound.shapes().iter().map(part_depth).fold(0.0f32, f32::max) as f64;
+    }
+    let projection = shape.project_local_point(local, false);
+    if projection.is_inside {
+        (projection.point - local).length() as f64
+    } else {
+        0.0
+    }
+}
+
+/// Whether `collider` is one convex piece, whose body's centre of mass then
+/// lies inside it (a decomposed bowl's centre may lie in its open cavity).
+fn is_one_convex_piece(collider: &Collider) -> bool {
+    let shape = collider.shape();
+    shape.as_shape::<FaceHull>().is_some() || shape.as_compound().is_some_and(|c| c.shapes().len() == 1)
 }
 
 impl World {

@@ -155,14 +155,14 @@ position = [0.0, 0.01, 0.0]
 
 #[test]
 fn objects_overlapping_at_the_start_are_an_error_and_touching_ones_are_not() {
-    // Two 4 cm blocks, the upper one set `gap` above the lower one's top face.
-    let stack = |gap: f64| {
+    // Two 4 cm blocks, the upper one at `x` and set `gap` above the lower one's top face.
+    let place = |x: f64, gap: f64| {
         let text = format!(
             "duration = 0.1\nsample_rate = 16000\n[ground]\n\
              [[objects]]\nname = \"low\"\nmesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
              material = \"wood\"\nposition = [0.0, 0.01, 0.0]\n\
              [[objects]]\nname = \"up\"\nmesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
-             material = \"wood\"\nposition = [0.005, {}, 0.0]\n",
+             material = \"wood\"\nposition = [{x}, {}, 0.0]\n",
             0.03 + gap
         );
         let scene = Scene::from_toml_str(&text, Path::new(".")).expect("scene parses");
@@ -170,6 +170,7 @@ fn objects_overlapping_at_the_start_are_an_error_and_touching_ones_are_not() {
         p.insert("box", common::block([0.04, 0.02, 0.04], &[2000.0]));
         render(&scene, &mut p, &RenderOptions::default())
     };
+    let stack = |gap: f64| place(0.005, gap);
     match stack(-0.002) {
         Err(e @ SceneError::Invalid { .. }) => {
             let m = e.to_string();
@@ -180,8 +181,28 @@ fn objects_overlapping_at_the_start_are_an_error_and_touching_ones_are_not() {
         }
         other => panic!("expected an overlap error, got {other:?}"),
     }
+    let copy = place(0.0, -0.02).expect_err("a copy at the same place is an overlap").to_string();
+    assert!(copy.contains("'up' overlaps object 'low' by"), "{copy}");
     stack(0.0).expect("blocks exactly touching render");
     stack(-0.5 * modal_scene::START_OVERLAP_TOLERANCE_M).expect("an overlap within the tolerance renders");
+}
+
+#[test]
+fn an_exact_copy_of_an_object_at_its_place_is_an_overlap() {
+    // parry's query read these two boxes (hulls of 94 surface nodes) as
+    // touching, and the render blew them apart with 9 impacts.
+    let text = "duration = 0.1\nsample_rate = 16000\n[ground]\n\
+                [[objects]]\nname = \"b\"\nmesh = { generate = \"box\", size = [0.05, 0.03, 0.04] }\n\
+                material = \"steel\"\nposition = [0.0, 0.1, 0.0]\n\
+                [[objects]]\nname = \"c\"\nmesh = { generate = \"box\", size = [0.05, 0.03, 0.04] }\n\
+                material = \"steel\"\nposition = [0.0, 0.1, 0.0]\n";
+    let scene = Scene::from_toml_str(text, Path::new(".")).expect("scene parses");
+    let mesh = modal_mesh::generate::box_mesh([0.05, 0.03, 0.04], [5, 3, 4]);
+    let mut p = InMemoryProvider::new();
+    p.insert("box", common::bank_on(&mesh, modal_fem::Material::preset("steel").expect("steel"), &[9000.0]));
+    let error = render(&scene, &mut p, &RenderOptions::default()).expect_err("an overlap").to_string();
+    // The centre of one lies 1.5 cm (half the height) inside the other.
+    assert!(error.contains("objects[1].position: object 'c' overlaps object 'b' by 0.0150 m"), "{error}");
 }
 
 #[test]
