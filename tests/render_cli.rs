@@ -89,6 +89,23 @@ fn identical_assets_are_solved_once_and_both_sound() {
 }
 
 #[test]
+fn a_bank_stopped_by_its_mode_count_is_said_on_every_render() {
+    // A 30 cm bar keeping 3 modes stops far below 8 kHz: the user is told,
+    // also when the bank comes from the cache.
+    let dir = temp_dir();
+    let scene = "duration = 0.2\nsample_rate = 16000\n[ground]\n[[objects]]\n\
+                 mesh = { generate = \"box\", size = [0.3, 0.02, 0.03], element_size = 0.01 }\n\
+                 material = \"aluminium\"\nposition = [0.0, 0.05, 0.0]\nmodes = 3\n";
+    std::fs::write(dir.path().join("s.toml"), scene).unwrap();
+    let args = ["render", "s.toml", "-o", "s.wav", "--radiation", "estimate"];
+    for run in 0..2 {
+        let out = modal(dir.path(), &args).ok();
+        let said = out.stderr.lines().filter(|l| l.contains("keeps 3 modes, the highest at")).count();
+        assert_eq!(said, 1, "run {run}: {}", out.stderr);
+    }
+}
+
+#[test]
 fn bad_scenes_name_the_field_and_write_nothing() {
     let dir = temp_dir();
     let cases = [

@@ -39,6 +39,7 @@ pub(crate) fn with_slab(scene: &Scene) -> Cow<'_, Scene> {
         order: None,
         scale: None,
         sheet_thickness: None,
+        modes: g.modes,
         position_m: [g.center_m[0], g.height_m - 0.5 * t, g.center_m[1]],
         rotation: RotationSpec::default(),
         linear_velocity_m_s: [0.0; 3],

@@ -62,7 +62,8 @@ pub use render::{
 pub use spec::{
     BodyKind, Channels, ColliderKind, ExplicitMaterial, GeneratorSpec, GroundSpec, ListenerSpec,
     MaterialSpec, MeshSource, ObjectSpec, Radiation, RotationSpec, Scene, SurfaceSpec,
-    AUTO_DECOMPOSITION_RATIO, DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SLAB_THICKNESS_M, DEMO_TOML, GENERATORS,
+    AUTO_DECOMPOSITION_RATIO, DEFAULT_ROLLING_RESISTANCE_M, DEFAULT_SCENE_MODES, DEFAULT_SLAB_THICKNESS_M,
+    DEMO_TOML, GENERATORS, MAX_SCENE_MODES,
 };
 pub use sustain::{
     speed_gate, ContactEvent, SustainedEvent, SCRAPE_REFERENCE_SPEED_M_S, SUSTAIN_MIN_SPEED_M_S,

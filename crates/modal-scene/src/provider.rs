@@ -30,6 +30,8 @@ pub struct BankRequest {
     pub sheet_thickness: Option<f64>,
     /// Highest frequency worth solving for [Hz]: the scene's Nyquist frequency.
     pub max_frequency_hz: f64,
+    /// Most modes kept (`None`: [`crate::DEFAULT_SCENE_MODES`]).
+    pub max_modes: Option<usize>,
 }
 
 /// The two mantissas of the standard solve bands: `{4, 6} kHz · 2^j`, the
@@ -80,6 +82,7 @@ impl BankRequest {
             scale: object.scale,
             sheet_thickness: object.sheet_thickness,
             max_frequency_hz: 0.5 * scene.sample_rate_hz as f64,
+            max_modes: object.modes,
         })
     }
 }

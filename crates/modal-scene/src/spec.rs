@@ -159,6 +159,9 @@ pub struct GroundSpec {
     /// Surface finish for sustained contact (default: the material's).
     #[serde(default)]
     pub surface: Option<SurfaceSpec>,
+    /// Most modes kept in a sounding slab's bank (`modes`, as for an object).
+    #[serde(default)]
+    pub modes: Option<usize>,
 }
 
 /// A surface finish (TOML table `surface`, all keys optional): a named
@@ -210,6 +213,13 @@ pub enum ColliderKind {
     /// more than [`AUTO_DECOMPOSITION_RATIO`], else `hull`.
     Auto,
 }
+
+/// Modes a scene object's bank keeps when its `modes` is not given (the
+/// precompute default).
+pub const DEFAULT_SCENE_MODES: usize = 64;
+
+/// Most modes a scene object's bank may keep (`modes`): each is a voice.
+pub const MAX_SCENE_MODES: usize = 5000;
 
 /// `collider = "auto"` decomposes a body whose convex hull is more than this
 /// many times its own volume (a bowl: ≈ 5; a box or sphere: ≈ 1).
@@ -397,6 +407,11 @@ pub struct ObjectSpec {
     /// winding number encloses.
     #[serde(default)]
     pub sheet_thickness: Option<f64>,
+    /// Most modes kept in the bank, the lowest first (`None`: the precompute
+    /// default, [`DEFAULT_SCENE_MODES`]); a large or soft object may have more
+    /// below the scene's Nyquist frequency.
+    #[serde(default)]
+    pub modes: Option<usize>,
     /// World position of the centre of mass [m].
     #[serde(rename = "position", default)]
     pub position_m: [f64; 3],

@@ -3,7 +3,7 @@
 
 use crate::material::resolve_material;
 use crate::roughness::{check_surface, resolve_surface};
-use crate::spec::{MeshSource, ObjectSpec, RotationSpec, Scene};
+use crate::spec::{MeshSource, ObjectSpec, RotationSpec, Scene, MAX_SCENE_MODES};
 use crate::SceneError;
 
 /// Longest scene accepted [s] (guards against giant allocations).
@@ -86,6 +86,13 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
         if let Some(h) = g.element_size_m {
             positive("ground.element_size", h)?;
         }
+        mode_count("ground.modes", g.modes)?;
+        if g.modes.is_some() && g.size_m.is_none() {
+            return Err(SceneError::invalid(
+                "ground.modes",
+                "applies to a sounding slab (a ground with `size`) only",
+            ));
+        }
         if let Some(size) = g.size_m {
             let h = g.element_size_m.unwrap_or(g.thickness_m);
             let cells =
@@ -156,6 +163,7 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
             ));
         }
     }
+    mode_count(&key("modes"), o.modes)?;
     finite3(&key("position"), o.position_m)?;
     match &o.rotation {
         RotationSpec::AxisAngle { axis, angle } => {
@@ -235,5 +243,15 @@ fn unit_interval(path: &str, v: f64) -> Result<(), SceneError> {
         Ok(())
     } else {
         Err(SceneError::invalid(path, format!("must lie in [0, 1], got {v}")))
+    }
+}
+
+/// A bank's mode count (`modes`), if given, must be 1 ..= [`MAX_SCENE_MODES`].
+fn mode_count(key: &str, modes: Option<usize>) -> Result<(), SceneError> {
+    match modes {
+        Some(n) if !(1..=MAX_SCENE_MODES).contains(&n) => {
+            Err(SceneError::invalid(key, format!("must be between 1 and {MAX_SCENE_MODES}, got {n}")))
+        }
+        _ => Ok(()),
     }
 }

@@ -188,6 +188,26 @@ fn objects_overlapping_at_the_start_are_an_error_and_touching_ones_are_not() {
 }
 
 #[test]
+fn an_objects_mode_count_reaches_its_bank_request_and_is_bounded() {
+    let scene = |modes: &str| {
+        format!(
+            "duration = 0.1\nsample_rate = 16000\n[[objects]]\nmesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
+             material = \"wood\"\nposition = [0.0, 0.5, 0.0]\n{modes}"
+        )
+    };
+    let text = scene("modes = 200\n");
+    let parsed = Scene::from_toml_str(&text, Path::new(".")).expect("scene parses");
+    let mut p = InMemoryProvider::new();
+    p.insert("box", common::block([0.04, 0.02, 0.04], &[2000.0]));
+    render(&parsed, &mut p, &RenderOptions::default()).expect("render");
+    assert_eq!(p.requests[0].max_modes, Some(200));
+    for bad in ["modes = 0\n", "modes = 5001\n"] {
+        let e = Scene::from_toml_str(&scene(bad), Path::new(".")).expect_err("out of range").to_string();
+        assert!(e.contains("objects[0].modes: must be between 1 and 5000"), "{e}");
+    }
+}
+
+#[test]
 fn an_exact_copy_of_an_object_at_its_place_is_an_overlap() {
     // parry's query read these two boxes (hulls of 94 surface nodes) as
     // touching, and the render blew them apart with 9 impacts.
