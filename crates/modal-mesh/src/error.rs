@@ -156,7 +156,8 @@ pub enum MeshError {
     },
     /// A generated mesh would be absurdly large.
     #[error(
-        "the requested mesh would have {count} tets, more than the limit {limit}; use a larger element size"
+        "the requested mesh would have {count} tets, more than the limit {limit}, even at the default size if none \
+         was given; give a larger element size (`--h`, or `element_size` in a scene)"
     )]
     TooManyElements {
         /// Requested tet count.

@@ -57,6 +57,31 @@ pub const MAX_CURVED_CELL_PER_WALL: f64 = 2.0;
 /// thicknesses was up to 8.5 % high on its shell modes against 20).
 pub const MAX_AXIAL_CELL_PER_WALL: f64 = 16.0;
 
+/// The thinnest dimension of a generated shape must be at least this
+/// fraction of its largest (a 1 m sheet 0.1 mm thick). Below it no solid
+/// rings as one, the wall is almost surely a unit slip (a bowl with a
+/// `--thickness 1e-9`), and the solve would stall on a mesh of needles.
+pub const MIN_THIN_TO_LARGE: f64 = 1e-4;
+
+/// Refuses a shape thinner than [`MIN_THIN_TO_LARGE`] of its size.
+fn check_proportions(shape: &Shape) -> Result<(), MeshError> {
+    let (thinnest, largest) = shape.extents();
+    // Non-positive or non-finite sizes are each generator's own refusal.
+    if thinnest > 0.0 && largest.is_finite() && thinnest < MIN_THIN_TO_LARGE * largest {
+        return Err(MeshError::InvalidParameter {
+            name: "thickness",
+            message: format!(
+                "the thinnest dimension ({} m) is below 1/{:.0} of the largest ({} m): no solid this \
+                 thin rings as one; check the units",
+                crate::readable(thinnest),
+                1.0 / MIN_THIN_TO_LARGE,
+                crate::readable(largest)
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// A shape to mesh; all lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
@@ -272,6 +297,7 @@ fn smallest_fitting(lo: f64, hi: f64, fits: impl Fn(f64) -> bool) -> f64 {
 
 /// [`generate`] with the axial size of a tube set apart ([`ElementSizes`]).
 pub fn generate_sized(shape: &Shape, sizes: ElementSizes, order: u8) -> Result<TetMesh, MeshError> {
+    check_proportions(shape)?;
     let h = sizes.h;
     positive("h", h)?;
     mapped::check_order(order)?;
@@ -297,6 +323,19 @@ pub fn generate_sized(shape: &Shape, sizes: ElementSizes, order: u8) -> Result<T
 #[cfg(test)]
 mod budget_tests {
     use super::*;
+
+    #[test]
+    fn a_shape_thinner_than_a_ten_thousandth_of_its_size_is_refused() {
+        let sizes = ElementSizes::uniform(0.01);
+        let bowl = Shape::Bowl { radius: 0.06, thickness: 1e-9 };
+        let e = generate_sized(&bowl, sizes, 2).expect_err("a 1 nm wall").to_string();
+        assert!(e.contains("thinnest dimension (1e-9 m) is below 1/10000 of the largest (0.12 m)"), "{e}");
+        let tube = Shape::Tube { inner_radius: 0.01, outer_radius: 0.0100001, length: 0.3 };
+        assert!(generate_sized(&tube, sizes, 1).is_err());
+        // A 1 m sheet 0.2 mm thick is a real object (checked before any meshing).
+        let sheet = Shape::Box { size: [1.0, 2e-4, 1.0] };
+        assert!(check_proportions(&sheet).is_ok());
+    }
 
     /// The count is what the generator makes, for every shape.
     #[test]
