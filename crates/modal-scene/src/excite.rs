@@ -165,8 +165,12 @@ impl Exciter {
             let share = rise / total;
             let time = if fresh {
                 let gap = pair.points.iter().map(|p| p.separation_m).fold(f64::INFINITY, f64::min);
-                let lead = if approach > 0.0 && gap > 0.0 { (gap / approach).min(dt) } else { 0.0 };
-                t0 + lead
+                if approach > 0.0 && gap > 0.0 {
+                    t0 + (gap / approach).min(dt)
+                } else {
+                    // Swept there in the step before, and waited (physics.rs).
+                    t0 - pair.swept_lag_s
+                }
             } else {
                 t0 + 0.5 * dt
             };

@@ -130,6 +130,10 @@ pub(crate) struct PairContacts {
     pub normal: [f64; 3],
     /// Points with an impulse.
     pub points: Vec<ContactPoint>,
+    /// How long before this step's start a body of the pair reached the
+    /// contact, swept there by continuous collision detection in the step
+    /// before [s] (0 for other contacts; [`World::swept_arrival_lag`]).
+    pub swept_lag_s: f64,
 }
 
 /// The rapier world plus the bookkeeping that maps colliders to objects.
@@ -141,6 +145,13 @@ pub(crate) struct World {
     pub sides: Vec<ContactSide>,
     /// Pre-step velocity state of each object: (linvel, angvel, world com).
     pre_step: Vec<([f64; 3], [f64; 3], [f64; 3])>,
+    /// The same one step earlier, with whether the body was fast in that step
+    /// (swept by CCD); `None` before the second step.
+    step_before: Option<Vec<(([f64; 3], [f64; 3], [f64; 3]), bool)>>,
+    /// Per object: fast (swept) in the step just taken.
+    fast: Vec<bool>,
+    /// Whether a step was taken.
+    stepped: bool,
     /// Per object: rolling-resistance lever arm [m].
     rolling_m: Vec<f64>,
     /// Per object: the centre of mass of a fixed body (its scene position), which
@@ -409,6 +420,7 @@ impl World {
             });
         }
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
+        let n_objects = bodies.len();
         check_overlaps(&world, &bodies, scene)?;
         open_start_gaps(&mut world, &bodies, scene.gravity_m_s2);
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
@@ -420,6 +432,9 @@ impl World {
             bodies,
             sides,
             pre_step,
+            step_before: None,
+            fast: vec![false; n_objects],
+            stepped: false,
             rolling_m,
             fixed_com,
             normal_ns,
@@ -447,6 +462,10 @@ impl World {
 
     /// Advances by one step.
     pub fn step(&mut self) {
+        if self.stepped {
+            self.step_before = Some(self.pre_step.iter().copied().zip(self.fast.iter().copied()).collect());
+        }
+        self.stepped = true;
         for (i, h) in self.bodies.iter().enumerate() {
             let b = &self.world.bodies[*h];
             self.pre_step[i] = (d3(b.linvel()), d3(b.angvel()), d3(b.center_of_mass()));
@@ -470,13 +489,15 @@ impl World {
     /// fast bodies flying into each other still rely on contact prediction.
     fn update_bullets(&mut self) {
         let dt = self.world.integration_parameters.dt;
-        for (h, thickness) in self.bodies.iter().zip(&self.ccd_thickness_m) {
+        for (i, (h, thickness)) in self.bodies.iter().zip(&self.ccd_thickness_m).enumerate() {
             let b = &self.world.bodies[*h];
+            self.fast[i] = false;
             if !b.is_dynamic() || b.is_sleeping() {
                 continue;
             }
             let reach = b.linvel().length() + b.angvel().length() * b.mass_properties().max_extent();
             let fast = reach * dt > 0.25 * thickness;
+            self.fast[i] = fast;
             if fast != b.is_ccd_enabled() {
                 self.world.bodies[*h].enable_ccd(fast);
             }
@@ -527,8 +548,36 @@ impl World {
                 let key = (pair.collider1.into_raw_parts().0, pair.collider2.into_raw_parts().0);
                 let length = dot(normal, normal).sqrt();
                 let normal = if length > 0.0 { normal.map(|x| x / length) } else { [0.0, 1.0, 0.0] };
-                out.push(PairContacts { key, sides, normal, points });
+                let swept_lag_s = sides.iter().map(|&s| self.swept_arrival_lag(s, dt)).fold(0.0, f64::max);
+                out.push(PairContacts { key, sides, normal, points, swept_lag_s });
             }
+        }
+    }
+
+    /// How long before the start of the last step contact side `side`'s body
+    /// stopped short, swept by CCD [s]. Rapier's CCD stops a fast body at its
+    /// time of impact and drops the rest of that step's motion, and the
+    /// bounce comes in the next step: timed at that step's start, an impact
+    /// was up to one step late (16 ms at `physics_rate = 60`). The motion
+    /// lost, `(v·dt + g·dt²/2) − Δx` over the step before, divided by the
+    /// speed, is how long the body waited at the contact. 0 unless the body
+    /// was fast (swept) in that step.
+    pub fn swept_arrival_lag(&self, side: usize, dt: f64) -> f64 {
+        let (Some(i), Some(before)) = (self.sides.get(side).and_then(|s| s.object), &self.step_before) else {
+            return 0.0;
+        };
+        let ((v, _, c0), fast) = before[i];
+        if !fast || !self.sides[side].mass_kg.is_finite() {
+            return 0.0;
+        }
+        let c1 = self.pre_step[i].2;
+        let expected = [0, 1, 2].map(|k| v[k] * dt + 0.5 * self.gravity[k] * dt * dt);
+        let lost = sub(expected, sub(c1, c0));
+        let speed = dot(v, v).sqrt();
+        if speed > 0.0 {
+            (dot(lost, lost).sqrt() / speed).min(dt)
+        } else {
+            0.0
         }
     }
 

@@ -83,3 +83,29 @@ fn a_fast_ball_bounces_off_a_decomposed_bowl_wall_without_tunnelling() {
         );
     }
 }
+
+#[test]
+fn a_swept_impact_is_timed_when_the_body_arrives_not_at_the_next_step() {
+    // A 1 cm ball at `speed` in zero gravity, 0.3 m above a fixed 3 mm steel
+    // plate, at a game's physics rate: it arrives after (0.3 − 0.01 − 0.0015)/v.
+    // Continuous collision detection stops it there and the bounce comes in
+    // the next step; timed at that step's start it was up to 16 ms late.
+    for speed in [5.0, 10.0, 40.0] {
+        let text = format!(
+            "duration = 0.2\nsample_rate = 16000\nphysics_rate = 60\ngravity = [0.0, 0.0, 0.0]\n\
+             [listener]\nchannels = \"mono\"\n\
+             [[objects]]\nname = \"plate\"\nbody = \"fixed\"\n\
+             mesh = {{ generate = \"box\", size = [0.3, 0.003, 0.3] }}\nmaterial = \"steel\"\n\
+             [[objects]]\nname = \"ball\"\nmesh = {{ generate = \"sphere\", radius = 0.01 }}\n\
+             material = \"steel\"\nposition = [0.0, 0.3, 0.0]\nlinear_velocity = [0.0, -{speed}, 0.0]\n"
+        );
+        let scene = Scene::from_toml_str(&text, Path::new(".")).expect("scene");
+        let mut p = InMemoryProvider::new();
+        p.insert("box", common::block([0.3, 0.003, 0.3], &[2000.0]));
+        p.insert("sphere", common::ball(0.01, &[8000.0]));
+        let out = render(&scene, &mut p, &RenderOptions { collect_events: true }).expect("render");
+        let first = out.events.first().expect("an impact");
+        let arrival = (0.3 - 0.01 - 0.0015) / speed;
+        assert!((first.time_s - arrival).abs() < 2e-4, "{speed} m/s: at {} s, not {arrival} s", first.time_s);
+    }
+}
