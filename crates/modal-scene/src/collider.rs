@@ -34,6 +34,9 @@
 //!   (a 2 cm ball at 0.5 m/s left the floor every ≈ 0.1 s), which is heard as
 //!   ticks when it should roll smoothly (issue #16).
 //!
+//! - likewise a dynamic body whose hull is a circular cylinder (a solid
+//!   cylinder, a tube, a can; [`cylinder_of`]): an exact cylinder.
+//!
 //! Every convex polyhedron (a hull, each part of a decomposition) is a
 //! [`FaceHull`]: parry's own polyhedron reduces a face with many vertices to
 //! its first 4 when generating contacts, which let a flat thin disc sink
@@ -84,11 +87,12 @@ impl ShapeCache {
             return Ok(s.clone());
         }
         let points = surface_points(bank);
-        let hull = || {
-            reduced_hull(&points).ok_or_else(|| SceneError::Collider {
+        let hull = || match cylinder_of(bank) {
+            Some(cylinder) => Ok(cylinder.shape()),
+            None => reduced_hull(&points).ok_or_else(|| SceneError::Collider {
                 path: path.into(),
                 message: "degenerate convex hull".into(),
-            })
+            }),
         };
         let sphere = match kind {
             ColliderKind::Hull | ColliderKind::Auto => sphere_of(bank),
@@ -132,11 +136,14 @@ impl ShapeCache {
         path: &str,
     ) -> Result<Option<SharedShape>, SceneError> {
         let shape = self.dynamic_shape(bank, ColliderKind::Hull, path)?;
-        if shape.as_compound().is_some() {
+        if sphere_of(bank).is_some() {
             return Ok(Some(shape)); // the exact ball
         }
+        // The faceted hull's volume, not an exact cylinder's: a hollow tube is
+        // not convex, and a faceted solid cylinder's mesh is its faceted hull.
+        let Some(faceted) = reduced_hull(&surface_points(bank)) else { return Ok(None) };
         let mesh_volume = bank.mass.mass_kg / bank.material.density_kg_m3;
-        let hull_volume = shape.mass_properties(1.0).mass() as f64;
+        let hull_volume = faceted.mass_properties(1.0).mass() as f64;
         Ok((hull_volume <= FIXED_CONVEX_RATIO * mesh_volume).then_some(shape))
     }
 }
@@ -154,6 +161,90 @@ fn sphere_of(bank: &ModeBank) -> Option<([f64; 3], f64)> {
     let mean = p.iter().map(dist).sum::<f64>() / p.len() as f64;
     let round = mean > 0.0 && p.iter().all(|x| (dist(x) - mean).abs() <= SPHERE_TOLERANCE * mean);
     round.then_some((centre, mean))
+}
+
+/// Nodes within this fraction of a cylinder's length of a cap lie on it, and
+/// within this fraction of its radius of the round side ([`cylinder_of`]);
+/// the side's is looser, for a polygon's vertices seen from its bounding
+/// box's centre.
+pub const CYLINDER_TOLERANCE: f64 = 1e-3;
+const CYLINDER_SIDE_TOLERANCE: f64 = 1e-2;
+
+/// Largest angle between neighbouring rim nodes of a round cap [rad]: a
+/// 12-gon is round, a hexagonal pencil is not.
+pub const MAX_RIM_GAP_RAD: f64 = std::f64::consts::PI / 6.0;
+
+/// A circular cylinder along a mesh-frame axis (mesh frame, metres).
+struct RoundHull {
+    axis: usize,
+    centre: [f64; 3],
+    radius: f64,
+    half_length: f64,
+}
+
+impl RoundHull {
+    /// parry's cylinder (axis y) turned onto the axis, in a one-part compound
+    /// as the exact ball is.
+    fn shape(&self) -> SharedShape {
+        let mut axis = Vector::ZERO;
+        axis[self.axis] = 1.0;
+        let rotation = Rotation::from_rotation_arc(Vector::Y, axis);
+        let c = self.centre.map(|x| x as f32);
+        let pose = Pose::from_parts(Vector::new(c[0], c[1], c[2]), rotation);
+        SharedShape::compound(vec![(
+            pose,
+            SharedShape::cylinder(self.half_length as f32, self.radius as f32),
+        )])
+    }
+}
+
+/// The cylinder that is the convex hull of the surface nodes, if there is
+/// one: along a bounding-box axis with (nearly) equal extents across it, its
+/// radius the farthest node's from the axis, and both end rims round (nodes
+/// at that radius all around, no gap wider than [`MAX_RIM_GAP_RAD`]). A solid cylinder, a
+/// tube, a can. Its faceted hull rolls on facet edges, loses speed at each
+/// (a tube rolling at 0.2 m/s with no rolling resistance covered 0.30 m of
+/// 0.40 m in 2 s) and is heard as ticks, as a faceted ball was. A disc
+/// (shorter than its radius) keeps its faceted hull: parry approximates a
+/// cylinder's cap by a square in contacts, and `meshes/spin.toml`'s Euler's
+/// disk, which runs on its cap's rim, then slid flat with no landing.
+fn cylinder_of(bank: &ModeBank) -> Option<RoundHull> {
+    let p = &bank.surface.positions;
+    if p.len() < 24 {
+        return None;
+    }
+    let (lo, hi) = bank.surface.bounding_box();
+    let extent: [f64; 3] = std::array::from_fn(|c| hi[c] - lo[c]);
+    let centre: [f64; 3] = std::array::from_fn(|c| 0.5 * (lo[c] + hi[c]));
+    (0..3).find_map(|axis| {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        if (extent[u] - extent[v]).abs() > 5.0 * CYLINDER_SIDE_TOLERANCE * extent[u].max(extent[v]) {
+            return None;
+        }
+        let off_axis = |x: &[f64; 3]| (x[u] - centre[u]).hypot(x[v] - centre[v]);
+        let radius = p.iter().map(off_axis).fold(0.0, f64::max);
+        if !(radius > 0.0) || extent[axis] < radius {
+            return None; // degenerate, or a disc: see the doc above
+        }
+        let round_rim = |end: f64| {
+            let mut angles: Vec<f64> = p
+                .iter()
+                .filter(|x| (x[axis] - end).abs() <= CYLINDER_TOLERANCE * extent[axis])
+                .filter(|x| off_axis(x) >= radius * (1.0 - CYLINDER_SIDE_TOLERANCE))
+                .map(|x| (x[v] - centre[v]).atan2(x[u] - centre[u]))
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            let (Some(first), Some(last)) = (angles.first(), angles.last()) else { return false };
+            let wrap = first + std::f64::consts::TAU - last;
+            angles.windows(2).map(|w| w[1] - w[0]).fold(wrap, f64::max) <= MAX_RIM_GAP_RAD
+        };
+        (round_rim(lo[axis]) && round_rim(hi[axis])).then_some(RoundHull {
+            axis,
+            centre,
+            radius,
+            half_length: 0.5 * extent[axis],
+        })
+    })
 }
 
 /// The surface nodes as rapier vectors (mesh frame).
@@ -372,6 +463,23 @@ mod tests {
             extreme_points_reference(&sphere_points(3000), 384)
         );
         assert!(extreme_points(&[], 8).is_empty());
+    }
+
+    fn bank_of(mesh: &modal_mesh::TetMesh) -> ModeBank {
+        crate::stand_in::synthetic_bank(mesh, modal_fem::Material::preset("steel").expect("steel"), &[1000.0])
+    }
+
+    #[test]
+    fn round_hulls_are_found_and_others_are_not() {
+        use modal_mesh::generate::{bowl, box_mesh, cylinder, tube};
+        let tube = cylinder_of(&bank_of(&tube(0.027, 0.03, 0.15, 0.006, 1).expect("tube"))).expect("a tube");
+        assert_eq!(tube.axis, 2);
+        assert!((tube.radius - 0.03).abs() < 1e-9 && (tube.half_length - 0.075).abs() < 1e-9);
+        assert!(cylinder_of(&bank_of(&cylinder(0.02, 0.1, 0.005, 2).expect("rod"))).is_some());
+        // A square bar, a disc (kept faceted: see `cylinder_of`) and a bowl are not.
+        assert!(cylinder_of(&bank_of(&box_mesh([0.02, 0.3, 0.02], [2, 30, 2]))).is_none());
+        assert!(cylinder_of(&bank_of(&cylinder(0.04, 0.006, 0.006, 2).expect("disc"))).is_none());
+        assert!(cylinder_of(&bank_of(&bowl(0.06, 0.004, 0.01, 2).expect("bowl"))).is_none());
     }
 
     #[test]
