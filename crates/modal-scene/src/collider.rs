@@ -223,7 +223,7 @@ fn cylinder_of(bank: &ModeBank) -> Option<RoundHull> {
         }
         let off_axis = |x: &[f64; 3]| (x[u] - centre[u]).hypot(x[v] - centre[v]);
         let radius = p.iter().map(off_axis).fold(0.0, f64::max);
-        if !(radius > 0.0) || extent[axis] < radius {
+        if radius <= 0.0 || extent[axis] < radius {
             return None; // degenerate, or a disc: see the doc above
         }
         let round_rim = |end: f64| {

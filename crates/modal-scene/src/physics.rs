@@ -136,6 +136,10 @@ pub(crate) struct PairContacts {
     pub swept_lag_s: f64,
 }
 
+/// A body's linear velocity [m/s], angular velocity [rad/s] and centre of
+/// mass [m], world frame.
+type BodyState = ([f64; 3], [f64; 3], [f64; 3]);
+
 /// The rapier world plus the bookkeeping that maps colliders to objects.
 pub(crate) struct World {
     world: PhysicsWorld,
@@ -143,11 +147,11 @@ pub(crate) struct World {
     bodies: Vec<RigidBodyHandle>,
     /// Contact sides: objects `0..n`, then the ground at index `n` if any.
     pub sides: Vec<ContactSide>,
-    /// Pre-step velocity state of each object: (linvel, angvel, world com).
-    pre_step: Vec<([f64; 3], [f64; 3], [f64; 3])>,
+    /// Pre-step velocity state of each object.
+    pre_step: Vec<BodyState>,
     /// The same one step earlier, with whether the body was fast in that step
     /// (swept by CCD); `None` before the second step.
-    step_before: Option<Vec<(([f64; 3], [f64; 3], [f64; 3]), bool)>>,
+    step_before: Option<Vec<(BodyState, bool)>>,
     /// Per object: fast (swept) in the step just taken.
     fast: Vec<bool>,
     /// Whether a step was taken.
