@@ -157,13 +157,10 @@ impl RadiationTable {
             if m.coefficients.iter().flatten().any(|c| !c.is_finite()) {
                 return bad(format!("radiation_coefficients of mode {}", m.mode), f64::NAN, "must be finite");
             }
-            let non_negative = |v: f64| v.is_finite() && v >= 0.0;
-            if !non_negative(m.power_w) || !non_negative(m.efficiency) {
-                return bad(
-                    format!("radiation_power_w[{i}]"),
-                    m.power_w,
-                    "power and efficiency must be finite, ≥ 0",
-                );
+            for (name, v) in [("radiation_power_w", m.power_w), ("radiation_efficiency", m.efficiency)] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return bad(format!("{name}[{i}]"), v, "must be finite and ≥ 0");
+                }
             }
         }
         Ok(())

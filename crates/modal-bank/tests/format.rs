@@ -596,3 +596,31 @@ fn load_agrees_with_from_bytes_on_good_and_bad_files() {
     }
     assert!(loaded >= 4, "{loaded} variants loaded");
 }
+
+#[test]
+fn forged_radiation_data_is_refused_naming_what_is_wrong() {
+    let bank = linear_bank(3);
+    let table = radiation_table(&bank);
+    let bytes = bank.to_bytes_with_radiation(&table).unwrap();
+    let load = |b: &[u8]| ModeBank::from_bytes_with_radiation(b).map(|_| ()).unwrap_err().to_string();
+    // Tensors whose metadata key is gone were ignored, and the level estimated.
+    let no_meta = rewrite(&bytes, |_, meta| {
+        meta.remove("radiation");
+    });
+    assert!(
+        load(&no_meta).contains("missing, though the file holds radiation tensors"),
+        "{}",
+        load(&no_meta)
+    );
+    // Another time convention was read as ours (every phase conjugated).
+    let other_convention = rewrite(&bytes, |_, meta| {
+        let json = meta["radiation"].replace("exp(-i omega t)", "exp(+i omega t)");
+        meta.insert("radiation".into(), json);
+    });
+    assert!(load(&other_convention).contains("exp(+i omega t)"), "{}", load(&other_convention));
+    // A NaN efficiency was reported as the power tensor with the power's value.
+    let mut bad = table.clone();
+    bad.modes[1].efficiency = f64::NAN;
+    let err = bank.to_bytes_with_radiation(&bad).unwrap_err().to_string();
+    assert!(err.contains("radiation_efficiency[1]") && err.contains("NaN"), "{err}");
+}

@@ -17,6 +17,8 @@ pub(crate) const T_RAD_POWER: &str = "radiation_power_w";
 pub(crate) const T_RAD_EFFICIENCY: &str = "radiation_efficiency";
 pub(crate) const T_RAD_COEFFICIENTS: &str = "radiation_coefficients";
 pub(crate) const KEY_RADIATION: &str = "radiation";
+/// The time convention of every stored transfer (`crate::radiation`).
+pub(crate) const CONVENTION: &str = "exp(-i omega t)";
 
 /// The `radiation` metadata value.
 #[derive(Serialize, Deserialize)]
@@ -60,7 +62,7 @@ pub(crate) fn metadata(table: &RadiationTable) -> Result<String, BankError> {
         air_density_kg_m3: table.air_density_kg_m3,
         sound_speed_m_s: table.sound_speed_m_s,
         tolerance: table.tolerance,
-        convention: "exp(-i omega t)".into(),
+        convention: CONVENTION.into(),
     };
     serde_json::to_string(&meta)
         .map_err(|e| BankError::BadMetadata { key: KEY_RADIATION.into(), detail: e.to_string() })
@@ -114,11 +116,19 @@ pub(crate) fn read(bytes: &[u8], bank: &crate::ModeBank) -> Result<Option<Radiat
     let st = SafeTensors::deserialize(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
     let (_, header) =
         SafeTensors::read_metadata(bytes).map_err(|e| BankError::NotSafetensors(e.to_string()))?;
+    let bad = |detail: String| BankError::BadMetadata { key: KEY_RADIATION.into(), detail };
     let Some(json) = header.metadata().as_ref().and_then(|m| m.get(KEY_RADIATION)) else {
+        // Tensors without their metadata would be ignored in silence, and the
+        // level estimated: the file was not written by us whole.
+        if st.names().iter().any(|n| n.starts_with("radiation_")) {
+            return Err(bad("missing, though the file holds radiation tensors".into()));
+        }
         return Ok(None);
     };
-    let meta: RadiationMeta = serde_json::from_str(json)
-        .map_err(|e| BankError::BadMetadata { key: KEY_RADIATION.into(), detail: e.to_string() })?;
+    let meta: RadiationMeta = serde_json::from_str(json).map_err(|e| bad(e.to_string()))?;
+    if meta.convention != CONVENTION {
+        return Err(bad(format!("convention {:?}: only {CONVENTION:?} is read", meta.convention)));
+    }
     let modes = read_usize(&st, T_RAD_MODES)?;
     let orders = read_usize(&st, T_RAD_ORDERS)?;
     let r = modes.len();
