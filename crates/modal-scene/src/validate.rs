@@ -111,6 +111,31 @@ pub(crate) fn validate(scene: &Scene) -> Result<(), SceneError> {
     for (i, object) in scene.objects.iter().enumerate() {
         validate_object(&format!("objects[{i}]"), object)?;
     }
+    unique_names(scene)
+}
+
+/// Reports, events and errors name objects: two objects of one name (given,
+/// or a default `object<i>`), or an object called like the ground, could not
+/// be told apart.
+fn unique_names(scene: &Scene) -> Result<(), SceneError> {
+    let mut first: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for i in 0..scene.objects.len() {
+        let name = scene.object_name(i);
+        if scene.ground.is_some() && name == crate::GROUND_NAME {
+            return Err(SceneError::invalid(
+                format!("objects[{i}].name"),
+                "\"ground\" names the [ground] in reports and events: choose another name",
+            ));
+        }
+        if let Some(j) = first.insert(name.clone(), i) {
+            return Err(SceneError::invalid(
+                format!("objects[{i}].name"),
+                format!(
+                    "'{name}' is also the name of objects[{j}]: reports and events could not tell them apart"
+                ),
+            ));
+        }
+    }
     Ok(())
 }
 

@@ -208,6 +208,26 @@ fn an_objects_mode_count_reaches_its_bank_request_and_is_bounded() {
 }
 
 #[test]
+fn two_objects_of_one_name_are_refused() {
+    let object = |name: &str, x: f64| {
+        format!(
+            "[[objects]]\n{name}mesh = {{ generate = \"box\", size = [0.04, 0.02, 0.04] }}\n\
+             material = \"wood\"\nposition = [{x}, 0.5, 0.0]\n"
+        )
+    };
+    let parse = |objects: String| Scene::from_toml_str(&format!("[ground]\n{objects}"), Path::new("."));
+    let twice = parse(object("name = \"cup\"\n", 0.0) + &object("name = \"cup\"\n", 0.2));
+    let e = twice.expect_err("duplicate").to_string();
+    assert!(e.contains("objects[1].name: 'cup' is also the name of objects[0]"), "{e}");
+    // A given name equal to another object's default one.
+    let e = parse(object("", 0.0) + &object("name = \"object0\"\n", 0.2)).expect_err("clash").to_string();
+    assert!(e.contains("objects[1].name: 'object0'"), "{e}");
+    let e = parse(object("name = \"ground\"\n", 0.0)).expect_err("the ground's name").to_string();
+    assert!(e.contains("objects[0].name: \"ground\" names the [ground]"), "{e}");
+    parse(object("name = \"a\"\n", 0.0) + &object("", 0.2)).expect("distinct names");
+}
+
+#[test]
 fn an_exact_copy_of_an_object_at_its_place_is_an_overlap() {
     // parry's query read these two boxes (hulls of 94 surface nodes) as
     // touching, and the render blew them apart with 9 impacts.
