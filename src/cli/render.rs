@@ -524,6 +524,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if wav.clipped > 0 {
         warn(&clipping_advice(wav.clipped, rendered.report.peak, scene.listener.gain));
     }
+    listener_warnings(&scene, &rendered.report).iter().for_each(|w| warn(w));
     let report = &rendered.report;
     if args.json {
         let mut json = serde_json::to_value(report)?;
@@ -591,6 +592,26 @@ fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, s
 
 /// The clipping warning, with the `[listener] gain` that would have fitted
 /// the peak (sample 1.0 is `20 Pa / gain`, so the peak scales with the gain).
+/// A listener set inside a body or under a solid ground plane: what it hears
+/// there is not physical, and nothing else would say so.
+fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<String> {
+    let at = scene.listener.position_m;
+    let mut warnings = Vec::new();
+    if let Some(name) = &report.listener_inside {
+        warnings.push(format!(
+            "the listener at {at:?} m starts inside object '{name}' (its collider): move [listener] position"
+        ));
+    }
+    if let Some(ground) = scene.ground.as_ref().filter(|g| g.size_m.is_none() && at[1] < g.height_m) {
+        warnings.push(format!(
+            "the listener at {at:?} m is below the ground plane (y = {} m), which is solid: move [listener] \
+             position",
+            ground.height_m
+        ));
+    }
+    warnings
+}
+
 fn clipping_advice(clipped: usize, peak: f64, gain: f64) -> String {
     // Two significant digits, rounded down so the advice does fit.
     let fitting = gain * 0.9 / peak;

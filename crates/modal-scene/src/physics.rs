@@ -459,6 +459,16 @@ impl World {
         rotate(q, v)
     }
 
+    /// The first object whose collider contains the world point `p`.
+    pub fn object_containing(&self, p: [f64; 3]) -> Option<usize> {
+        self.bodies.iter().position(|h| {
+            self.world.bodies[*h].colliders().iter().any(|c| {
+                let collider = &self.world.colliders[*c];
+                collider.shape().contains_point(collider.position(), v3(p))
+            })
+        })
+    }
+
     /// True when no dynamic body is awake.
     pub fn all_asleep(&self) -> bool {
         self.world.bodies.iter().all(|(_, b)| !b.is_dynamic() || b.is_sleeping())

@@ -208,6 +208,7 @@ fn simulate(
     let n = banks.len();
     let t = Instant::now();
     let mut world = World::new(scene, banks)?;
+    report.listener_inside = world.object_containing(scene.listener.position_m).map(|i| names[i].clone());
     report.colliders_s = t.elapsed().as_secs_f64();
     let dt = 1.0 / scene.physics_rate_hz;
     let steps = (scene.duration_s * scene.physics_rate_hz).ceil() as usize;

@@ -80,6 +80,10 @@ pub struct RenderReport {
     pub peak: f64,
     /// Samples beyond full scale.
     pub clipped_samples: usize,
+    /// The object whose collider holds the listener's position at the start,
+    /// if any (an authoring slip: a listener inside a body hears nothing
+    /// physical).
+    pub listener_inside: Option<String>,
 }
 
 impl RenderReport {

@@ -208,6 +208,23 @@ fn an_objects_mode_count_reaches_its_bank_request_and_is_bounded() {
 }
 
 #[test]
+fn a_listener_set_inside_an_object_is_reported() {
+    let scene = |listener: &str| {
+        let text = format!(
+            "duration = 0.1\nsample_rate = 16000\n[listener]\nposition = {listener}\nchannels = \"mono\"\n[ground]\n\
+             [[objects]]\nname = \"crate\"\nbody = \"fixed\"\nmesh = {{ generate = \"box\", size = [0.4, 0.2, 0.4] }}\n\
+             material = \"wood\"\nposition = [0.0, 0.1, 0.0]\n"
+        );
+        let scene = Scene::from_toml_str(&text, Path::new(".")).expect("scene parses");
+        let mut p = InMemoryProvider::new();
+        p.insert("box", common::block([0.4, 0.2, 0.4], &[900.0]));
+        render(&scene, &mut p, &RenderOptions::default()).expect("render").report.listener_inside
+    };
+    assert_eq!(scene("[0.05, 0.1, 0.0]"), Some("crate".to_string()));
+    assert_eq!(scene("[0.0, 0.3, 0.5]"), None);
+}
+
+#[test]
 fn two_objects_of_one_name_are_refused() {
     let object = |name: &str, x: f64| {
         format!(
