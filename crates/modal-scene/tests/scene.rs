@@ -242,6 +242,9 @@ fn two_objects_of_one_name_are_refused() {
     let e = parse(object("name = \"ground\"\n", 0.0)).expect_err("the ground's name").to_string();
     assert!(e.contains("objects[0].name: \"ground\" names the [ground]"), "{e}");
     parse(object("name = \"a\"\n", 0.0) + &object("", 0.2)).expect("distinct names");
+    // Far from the origin f32 physics cannot resolve a contact.
+    let e = parse(object("", 1e9)).expect_err("too far").to_string();
+    assert!(e.contains("objects[0].position: 1e9 m is beyond ±1000 m"), "{e}");
 }
 
 #[test]
