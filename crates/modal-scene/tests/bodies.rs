@@ -153,26 +153,27 @@ angular_velocity = [0.0, 2.0, 1.0]
     assert!(out.report.physics_steps > steps + 500, "{} steps", out.report.physics_steps);
 }
 
+/// A mono scene of `duration_s` at 16 kHz with one object (its TOML keys)
+/// on a ground plane with the keys `ground`.
+fn one_on_the_floor(duration_s: f64, ground: &str, object: &str) -> Scene {
+    let text = format!(
+        "duration = {duration_s}\nsample_rate = 16000\n[listener]\nchannels = \"mono\"\n[ground]\n{ground}\n\
+         [[objects]]\n{object}\n"
+    );
+    Scene::from_toml_str(&text, Path::new(".")).expect("scene")
+}
+
 #[test]
 fn a_slow_body_keeps_moving_until_it_is_at_rest() {
     // A block sliding at 5 cm/s on frictionless ice must not be put to sleep
     // as if it were at rest (rapier's 0.1 m/s rule stopped it after 1 cm).
-    let text = r#"
-duration = 1.0
-sample_rate = 16000
-[listener]
-channels = "mono"
-[ground]
-friction = 0.0
-[[objects]]
-name = "block"
+    let object = r#"name = "block"
 mesh = { generate = "box", size = [0.12, 0.03, 0.06] }
 material = "wood"
 position = [0.0, 0.015, 0.0]
 linear_velocity = [0.05, 0.0, 0.0]
-friction = 0.0
-"#;
-    let scene = Scene::from_toml_str(text, Path::new(".")).expect("scene");
+friction = 0.0"#;
+    let scene = one_on_the_floor(1.0, "friction = 0.0", object);
     let mut p = InMemoryProvider::new();
     p.insert("box", common::block([0.12, 0.03, 0.06], &[3000.0]));
     let out = render(&scene, &mut p, &RenderOptions::default()).expect("render");
@@ -184,22 +185,14 @@ friction = 0.0
 fn a_tube_rolls_on_as_a_round_body_does() {
     // A steel tube rolling at 0.2 m/s with no rolling resistance keeps its
     // speed; on its faceted hull it lost a quarter of the distance in 2 s.
-    let text = r#"
-duration = 2.0
-sample_rate = 16000
-[listener]
-channels = "mono"
-[ground]
-[[objects]]
-name = "tube"
+    let object = r#"name = "tube"
 mesh = { generate = "tube", radius = 0.03, inner_radius = 0.027, length = 0.15 }
 material = "steel"
 position = [0.0, 0.03, 0.0]
 linear_velocity = [0.2, 0.0, 0.0]
 angular_velocity = [0.0, 0.0, -6.6667]
-rolling_resistance = 0.0
-"#;
-    let scene = Scene::from_toml_str(text, Path::new(".")).expect("scene");
+rolling_resistance = 0.0"#;
+    let scene = one_on_the_floor(2.0, "", object);
     let steel = Material::preset("steel").expect("steel");
     let mesh = modal_mesh::generate::tube(0.027, 0.03, 0.15, 0.006, 1).expect("tube mesh");
     let mut p = InMemoryProvider::new();
