@@ -92,3 +92,16 @@ fn impossible_materials() {
         .fails_with("input file itself");
     assert_eq!(std::fs::read_to_string(dir.path().join("good.msh")).unwrap(), GOOD_MSH);
 }
+
+#[test]
+fn a_failure_asked_for_in_json_is_json_on_stdout() {
+    // Scripts read stdout; a failing `--json` command used to print nothing there.
+    let dir = temp_dir();
+    let run = modal(dir.path(), &["info", "missing.bank", "--json"]);
+    assert!(!run.success, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(run.stdout.trim()).expect("one JSON document");
+    let error = json["error"].as_str().expect("an error string");
+    assert!(error.contains("missing.bank") && run.stderr.contains(error), "{error} / {}", run.stderr);
+    // Without --json, stdout stays empty.
+    assert!(modal(dir.path(), &["info", "missing.bank"]).stdout.is_empty());
+}

@@ -31,12 +31,14 @@ pub use args::{Cli, Command};
 /// Parses the command line, runs the command and maps the outcome to an exit code.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
+    // `--json` is a flag of every command that has it, never an option's value.
+    let json = std::env::args_os().any(|a| a == "--json");
     interrupt::install();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
-            output::print_error(&err);
+            output::print_error(&err, json);
             ExitCode::from(1)
         }
     }

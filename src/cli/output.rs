@@ -1,8 +1,8 @@
 //! Shared output helpers: error lines, warnings, JSON, progress.
 
 /// Prints an error and its cause chain as one line on stderr.
-pub fn print_error(err: &anyhow::Error) {
-    let mut line = format!("error: {err}");
+pub fn print_error(err: &anyhow::Error, json: bool) {
+    let mut line = err.to_string();
     for cause in err.chain().skip(1) {
         let text = cause.to_string();
         // Contexts often repeat their cause; print each distinct part once.
@@ -11,7 +11,12 @@ pub fn print_error(err: &anyhow::Error) {
             line.push_str(&text);
         }
     }
-    eprintln!("{}", line.replace('\n', " "));
+    let line = line.replace('\n', " ");
+    eprintln!("error: {line}");
+    if json {
+        // A script reading the JSON on stdout gets the failure there too.
+        println!("{}", serde_json::json!({ "error": line }));
+    }
 }
 
 /// Prints a warning on stderr (never on stdout, which may hold JSON).
