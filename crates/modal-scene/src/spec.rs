@@ -14,6 +14,8 @@ use serde::Deserialize;
 
 use crate::SceneError;
 
+mod either;
+
 /// A whole scene: objects, ground, listener and render settings.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -225,12 +227,9 @@ pub const MAX_SCENE_MODES: usize = 5000;
 /// many times its own volume (a bowl: ≈ 5; a box or sphere: ≈ 1).
 pub const AUTO_DECOMPOSITION_RATIO: f64 = 1.5;
 
-/// A mesh asset: a file path or a generator recipe.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(
-    untagged,
-    expecting = "a mesh file path or a generator table like { generate = \"box\", size = [..] }"
-)]
+/// A mesh asset: a file path or a generator recipe (deserialized by hand in
+/// `either`, so that a bad key in the table is named).
+#[derive(Clone, Debug, PartialEq)]
 pub enum MeshSource {
     /// A mesh file, relative to the scene file (resolved when loading).
     File(PathBuf),
@@ -239,7 +238,8 @@ pub enum MeshSource {
 }
 
 /// A generated mesh, as plain data (`modal_mesh::generate`): which keys a
-/// generator needs is listed in `docs/scene-format.md`; lengths in metres.
+/// generator needs is listed in `docs/scene-format.md`; a key its shape does
+/// not read is refused ([`GeneratorSpec::unused_key`]); lengths in metres.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GeneratorSpec {
@@ -267,8 +267,11 @@ pub struct GeneratorSpec {
 
 impl GeneratorSpec {
     /// The `modal_mesh` shape this recipe describes; the error names the
-    /// missing or unknown key.
+    /// missing, unused or unknown key.
     pub fn shape(&self) -> Result<Shape, String> {
+        if let Some((_, why)) = self.unused_key() {
+            return Err(why);
+        }
         let need = |v: Option<f64>, key: &str| v.ok_or_else(|| format!("`{}` needs `{key}`", self.generate));
         Ok(match self.generate.as_str() {
             "box" => Shape::Box { size: self.size.ok_or_else(|| "`box` needs `size`".to_string())? },
@@ -288,14 +291,51 @@ impl GeneratorSpec {
             other => return Err(format!("unknown generator '{other}' (known: {})", GENERATORS.join(", "))),
         })
     }
+
+    /// A key given that this generator does not read, with a message naming
+    /// the keys it takes: a `radius` on a box was ignored without a word.
+    /// `None` for an unknown generator ([`GeneratorSpec::shape`] names it).
+    pub fn unused_key(&self) -> Option<(&'static str, String)> {
+        let (_, takes) = GENERATOR_KEYS.iter().find(|(name, _)| *name == self.generate)?;
+        let (unused, _) =
+            self.shape_keys_given().into_iter().find(|(key, given)| *given && !takes.contains(key))?;
+        let takes: Vec<String> = takes.iter().map(|key| format!("`{key}`")).collect();
+        let why = format!(
+            "`{}` does not take `{unused}`; it takes {} and `element_size`",
+            self.generate,
+            takes.join(", ")
+        );
+        Some((unused, why))
+    }
+
+    /// Each key that only some generators read, and whether it was given.
+    fn shape_keys_given(&self) -> [(&'static str, bool); 5] {
+        [
+            ("size", self.size.is_some()),
+            ("radius", self.radius.is_some()),
+            ("inner_radius", self.inner_radius.is_some()),
+            ("length", self.length.is_some()),
+            ("thickness", self.thickness.is_some()),
+        ]
+    }
 }
 
 /// Generator names accepted in `mesh = { generate = NAME, .. }`.
 pub const GENERATORS: [&str; 5] = ["box", "cylinder", "tube", "sphere", "bowl"];
 
-/// A material: a preset name or explicit constants.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(untagged, expecting = "a material preset name or a table { youngs, poisson, density, alpha, beta }")]
+/// The keys each generator reads in [`GeneratorSpec::shape`], besides
+/// `generate` and `element_size`, which every generator takes.
+const GENERATOR_KEYS: [(&str, &[&str]); 5] = [
+    ("box", &["size"]),
+    ("cylinder", &["radius", "length"]),
+    ("tube", &["inner_radius", "radius", "length"]),
+    ("sphere", &["radius"]),
+    ("bowl", &["radius", "thickness"]),
+];
+
+/// A material: a preset name or explicit constants (deserialized by hand in
+/// `either`, so that a bad key in the table is named).
+#[derive(Clone, Debug, PartialEq)]
 pub enum MaterialSpec {
     /// A preset such as `"steel"` (see `docs/scene-format.md`).
     Preset(String),
@@ -321,9 +361,9 @@ pub struct ExplicitMaterial {
     pub beta: f64,
 }
 
-/// An orientation, in degrees.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(untagged, expecting = "a rotation table { axis = [x, y, z], angle = DEG } or { euler = [X, Y, Z] }")]
+/// An orientation, in degrees: exactly one of the two forms, no other key
+/// (deserialized by hand in `either`).
+#[derive(Clone, Debug, PartialEq)]
 pub enum RotationSpec {
     /// Rotation by `angle` degrees about `axis` (right-hand rule).
     AxisAngle {

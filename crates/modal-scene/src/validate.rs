@@ -156,6 +156,9 @@ fn validate_object(at: &str, o: &ObjectSpec) -> Result<(), SceneError> {
             }
         }
         (Some(MeshSource::Generate(g)), None) => {
+            if let Some((unused, why)) = g.unused_key() {
+                return Err(SceneError::invalid(key(&format!("mesh.{unused}")), why));
+            }
             g.shape().map_err(|m| SceneError::invalid(key("mesh"), m))?;
             let lengths = [g.radius, g.inner_radius, g.length, g.thickness, g.element_size];
             let names = ["radius", "inner_radius", "length", "thickness", "element_size"];
