@@ -6,7 +6,9 @@ pub fn print_error(err: &anyhow::Error, json: bool) {
     for cause in err.chain().skip(1) {
         let text = cause.to_string();
         // Contexts often repeat their cause; print each distinct part once.
-        if !line.contains(&text) {
+        if text.starts_with(&line) {
+            line = text; // the cause already opens with the context (a file name)
+        } else if !line.contains(&text) {
             line.push_str(": ");
             line.push_str(&text);
         }

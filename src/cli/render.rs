@@ -442,7 +442,7 @@ fn describe(mesh: &modal_scene::MeshSource) -> String {
 pub fn run(args: RenderArgs) -> Result<()> {
     let (scene, default_out) = match &args.scene {
         Some(path) => {
-            let scene = Scene::from_file(path).with_context(|| format!("scene {}", path.display()))?;
+            let scene = Scene::from_file(path).with_context(|| path.display().to_string())?;
             let out = scene.output.clone().unwrap_or_else(|| path.with_extension("wav"));
             (scene, out)
         }
