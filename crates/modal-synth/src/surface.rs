@@ -18,7 +18,9 @@
 //! surface: on a curved body the corner triangle's chord lies inside it (a
 //! strike on a torus's equator snapped 0.79 mm in, its impulse tilted 7.6°
 //! off the normal; through the sub-triangles, ≈ 4× closer and the normal of
-//! the curved surface's own facet). The barycentric coordinates stay those
+//! the curved surface's own facet). The normal is the 6-node map's own
+//! where all three edges bow out of their chords, else the corner
+//! triangle's (`evenly_curved`). The barycentric coordinates stay those
 //! of the parent triangle's parametrization, as the shape functions need.
 
 use modal_mesh::{closest_point_on_triangle, Surface};
@@ -333,9 +335,25 @@ fn on_sub_triangles(surface: &Surface, edges: [usize; 3], flat: SurfacePoint, p:
             };
         }
     }
-    let curved = curved_normal(nodes.map(|n| surface.positions[n]), best.bary);
+    let x = nodes.map(|n| surface.positions[n]);
+    let curved = if evenly_curved(&x) { curved_normal(x, best.bary) } else { [0.0; 3] };
     best.normal = if curved == [0.0; 3] { flat.normal } else { curved };
     best
+}
+
+/// Whether every edge of the 6-node triangle `x` bows out of its chord, or
+/// none does. A triangle with some edges curved and others straight (a mesh
+/// curved only where its source surface was: the sweep's torus from an OBJ)
+/// has a quadratic map tilted near the curved edge (13° on that torus,
+/// against 7.6° for the chord's normal), so its chord's normal is used.
+fn evenly_curved(x: &[V3; 6]) -> bool {
+    let bows = [(0, 1, 3), (1, 2, 4), (2, 0, 5)].map(|(a, b, m)| {
+        let chord = sub(x[b], x[a]);
+        let mid = [0, 1, 2].map(|c| 0.5 * (x[a][c] + x[b][c]));
+        let off = sub(x[m], mid);
+        dot(off, off).sqrt() > 1e-6 * dot(chord, chord).sqrt()
+    });
+    bows.iter().all(|&b| b) || bows.iter().all(|&b| !b)
 }
 
 /// Unit normal `x_ξ × x_η` of the 6-node triangle with nodes `x` (corners,
