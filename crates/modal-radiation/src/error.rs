@@ -117,8 +117,11 @@ pub enum RadiationError {
         /// Frequency [Hz].
         frequency_hz: f64,
     },
-    /// The surface has more panels than the dense solver takes.
-    #[error("the surface has {panels} panels, more than the dense solver's {max}: mesh the object coarser (larger --h)")]
+    /// The surface has more panels than a solve with one unknown per panel takes.
+    #[error(
+        "the surface has {panels} panels, more than the {max} unknowns a full-resolution solve takes: drop \
+         --full-resolution, or mesh the object coarser (--cell for a surface mesh, --h for a generated one)"
+    )]
     TooManyPanels {
         /// Panels of the solve.
         panels: usize,
