@@ -268,3 +268,11 @@ fn scenes_at_44_1_and_48_khz_share_one_bank() {
         assert!(report["peak"].as_f64().unwrap() > 0.0, "{report}");
     }
 }
+
+#[test]
+fn a_scene_with_nothing_to_sound_says_so() {
+    let dir = temp_dir();
+    std::fs::write(dir.path().join("empty.toml"), "duration = 0.1\n").unwrap();
+    let run = modal(dir.path(), &["render", "empty.toml", "-o", "e.wav"]).ok();
+    assert!(run.stderr.contains("no object and no sounding ground: the WAV is silence"), "{}", run.stderr);
+}

@@ -592,11 +592,15 @@ fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, s
 
 /// The clipping warning, with the `[listener] gain` that would have fitted
 /// the peak (sample 1.0 is `20 Pa / gain`, so the peak scales with the gain).
-/// A listener set inside a body or under a solid ground plane: what it hears
-/// there is not physical, and nothing else would say so.
+/// A scene with nothing to sound, or a listener set inside a body or under a
+/// solid ground plane: what it hears is silence or not physical, and nothing
+/// else would say so.
 fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<String> {
     let at = scene.listener.position_m;
     let mut warnings = Vec::new();
+    if scene.objects.is_empty() && scene.ground.as_ref().is_none_or(|g| g.size_m.is_none()) {
+        warnings.push("the scene has no object and no sounding ground: the WAV is silence".to_string());
+    }
     if let Some(name) = &report.listener_inside {
         warnings.push(format!(
             "the listener at {at:?} m starts inside object '{name}' (its collider): move [listener] position"
