@@ -306,20 +306,21 @@ fn check_overlaps(world: &PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scen
 pub const START_GAP_M: f64 = 5e-5;
 
 /// Lifts each dynamic body that starts within [`START_GAP_M`] of a body whose
-/// centre lies lower (against gravity; +y without gravity) to that gap,
-/// lowest bodies first, so a stack opens from the bottom up. Colliders sit at
-/// their body's pose (no offset), so the body's pose is the collider's.
-fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], gravity: [f64; 3]) {
+/// centre of mass (the scene's `position`: rapier puts a fixed body's at its
+/// mesh origin) lies lower, against gravity (+y without gravity), to that
+/// gap, lowest bodies first, so a stack opens from the bottom up. Colliders
+/// sit at their body's pose (no offset), so the body's pose is the collider's.
+fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scene) {
+    let gravity = scene.gravity_m_s2;
     let g = dot(gravity, gravity).sqrt();
     let up = if g > 0.0 { gravity.map(|x| -x / g) } else { [0.0, 1.0, 0.0] };
-    let height = |w: &PhysicsWorld, h: RigidBodyHandle| dot(d3(w.bodies[h].center_of_mass()), up);
+    let height: Vec<f64> = scene.objects.iter().map(|o| dot(o.position_m, up)).collect();
     let mut order: Vec<usize> = (0..bodies.len()).filter(|&i| world.bodies[bodies[i]].is_dynamic()).collect();
-    order.sort_by(|&a, &b| height(world, bodies[a]).total_cmp(&height(world, bodies[b])));
+    order.sort_by(|&a, &b| height[a].total_cmp(&height[b]).then(a.cmp(&b)));
     for i in order {
-        let own = height(world, bodies[i]);
         let mut nearest = f64::INFINITY;
         for (j, other) in bodies.iter().enumerate() {
-            if j == i || height(world, *other) >= own {
+            if j == i || height[j] >= height[i] {
                 continue;
             }
             for a in world.bodies[bodies[i]].colliders() {
@@ -426,7 +427,7 @@ impl World {
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
         let n_objects = bodies.len();
         check_overlaps(&world, &bodies, scene)?;
-        open_start_gaps(&mut world, &bodies, scene.gravity_m_s2);
+        open_start_gaps(&mut world, &bodies, scene);
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
         let fixed_com =
             scene.objects.iter().map(|o| (o.body != BodyKind::Dynamic).then_some(o.position_m)).collect();
