@@ -136,12 +136,19 @@ impl ShapeCache {
         path: &str,
     ) -> Result<Option<SharedShape>, SceneError> {
         let shape = self.dynamic_shape(bank, ColliderKind::Hull, path)?;
-        if sphere_of(bank).is_some() {
-            return Ok(Some(shape)); // the exact ball
+        // A one-part compound is the exact ball or the exact cylinder; else
+        // the shape is the faceted hull itself.
+        let part = shape.as_compound().and_then(|c| c.shapes().first()).map(|(_, s)| s);
+        if part.is_some_and(|s| s.as_ball().is_some()) {
+            return Ok(Some(shape));
         }
         // The faceted hull's volume, not an exact cylinder's: a hollow tube is
         // not convex, and a faceted solid cylinder's mesh is its faceted hull.
-        let Some(faceted) = reduced_hull(&surface_points(bank)) else { return Ok(None) };
+        let faceted = match part {
+            Some(_) => reduced_hull(&surface_points(bank)),
+            None => Some(shape.clone()),
+        };
+        let Some(faceted) = faceted else { return Ok(None) };
         let mesh_volume = bank.mass.mass_kg / bank.material.density_kg_m3;
         let hull_volume = faceted.mass_properties(1.0).mass() as f64;
         Ok((hull_volume <= FIXED_CONVEX_RATIO * mesh_volume).then_some(shape))
