@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use modal_bank::{BankCache, CacheKey, ModeBank, RadiationTable};
 use modal_fem::Material;
 use modal_mesh::generate::ElementSizes;
@@ -457,10 +457,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Some(RadiationChoice::Transfer) => scene.listener.radiation = modal_scene::Radiation::Transfer,
         None => {}
     }
-    if let Some(n) = args.threads.filter(|n| !(1..=modal_precompute::MAX_THREADS).contains(n)) {
-        // Checked here, not only when a bank is solved: a cached scene accepted 0.
-        bail!("--threads must be between 1 and {}, got {n}", modal_precompute::MAX_THREADS);
-    }
+    // Checked here, not only when a bank is solved: a cached scene accepted 0.
+    modal_precompute::check_threads(args.threads)?;
     let out = args.out.clone().unwrap_or(default_out);
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;

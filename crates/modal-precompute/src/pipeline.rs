@@ -100,9 +100,7 @@ impl Request {
         if !(1..=MAX_MODES).contains(&self.max_modes) {
             return invalid(format!("--modes must be between 1 and {MAX_MODES}, got {}", self.max_modes));
         }
-        if let Some(n) = self.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
-            return invalid(format!("--threads must be between 1 and {MAX_THREADS}, got {n}"));
-        }
+        check_threads(self.threads)?;
         if let Some(a) = &self.accuracy {
             if !(a.target_pct.is_finite() && a.target_pct > 0.0) {
                 return invalid(format!(
@@ -131,6 +129,17 @@ pub const MAX_MODES: usize = 100_000;
 /// threads stalled for over a minute before any work; the largest common
 /// machines have a few hundred cores.
 pub const MAX_THREADS: usize = 1024;
+
+/// Refuses a thread count outside `1..=`[`MAX_THREADS`] (`None`: the default),
+/// for callers that must check it before a solve is known to be needed.
+pub fn check_threads(threads: Option<usize>) -> Result<(), PrecomputeError> {
+    match threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        Some(n) => {
+            Err(PrecomputeError::Invalid(format!("--threads must be between 1 and {MAX_THREADS}, got {n}")))
+        }
+        None => Ok(()),
+    }
+}
 
 /// Progress of the pipeline, for the CLI's progress display.
 #[derive(Clone, Debug, PartialEq)]
