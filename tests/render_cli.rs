@@ -275,4 +275,14 @@ fn a_scene_with_nothing_to_sound_says_so() {
     std::fs::write(dir.path().join("empty.toml"), "duration = 0.1\n").unwrap();
     let run = modal(dir.path(), &["render", "empty.toml", "-o", "e.wav"]).ok();
     assert!(run.stderr.contains("no object and no sounding ground: the WAV is silence"), "{}", run.stderr);
+    assert!(!run.stderr.contains("ear_spacing"), "{}", run.stderr);
+}
+
+#[test]
+fn ears_metres_apart_are_warned_about() {
+    // `ear_spacing = 50` meant as centimetres: two microphones 50 m apart.
+    let dir = temp_dir();
+    std::fs::write(dir.path().join("wide.toml"), "duration = 0.1\n[listener]\near_spacing = 50\n").unwrap();
+    let run = modal(dir.path(), &["render", "wide.toml", "-o", "w.wav"]).ok();
+    assert!(run.stderr.contains("ear_spacing = 50 m puts the ears 50 m apart"), "{}", run.stderr);
 }

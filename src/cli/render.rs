@@ -588,11 +588,12 @@ fn print_report(report: &modal_scene::RenderReport, out: &Path, cached: usize, s
     );
 }
 
-/// The clipping warning, with the `[listener] gain` that would have fitted
-/// the peak (sample 1.0 is `20 Pa / gain`, so the peak scales with the gain).
-/// A scene with nothing to sound, or a listener set inside a body or under a
-/// solid ground plane: what it hears is silence or not physical, and nothing
-/// else would say so.
+/// Widest ear spacing taken for a head [m]; wider pairs are warned about.
+const MAX_HEAD_EAR_SPACING_M: f64 = 1.0;
+
+/// A scene with nothing to sound, a listener set inside a body or under a
+/// solid ground plane, or ears metres apart: what it hears is silence, not
+/// physical or not a head, and nothing else would say so.
 fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<String> {
     let at = scene.listener.position_m;
     let mut warnings = Vec::new();
@@ -602,6 +603,15 @@ fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<S
     if let Some(name) = &report.listener_inside {
         warnings.push(format!(
             "the listener at {at:?} m starts inside object '{name}' (its collider): move [listener] position"
+        ));
+    }
+    let spacing = scene.listener.ear_spacing_m;
+    if spacing > MAX_HEAD_EAR_SPACING_M {
+        // A unit slip (50 meant as cm) would otherwise pass silently: the
+        // channels would be two microphones 50 m apart, 146 ms out of step.
+        warnings.push(format!(
+            "[listener] ear_spacing = {spacing} m puts the ears {spacing} m apart (a head is ≈ 0.2 m): \
+             the channels are two microphones that far apart; ear_spacing is in metres"
         ));
     }
     if let Some(ground) = scene.ground.as_ref().filter(|g| g.size_m.is_none() && at[1] < g.height_m) {
@@ -614,6 +624,8 @@ fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<S
     warnings
 }
 
+/// The clipping warning, with the `[listener] gain` that would have fitted
+/// the peak (sample 1.0 is `20 Pa / gain`, so the peak scales with the gain).
 fn clipping_advice(clipped: usize, peak: f64, gain: f64) -> String {
     // Two significant digits, rounded down so the advice does fit.
     let fitting = gain * 0.9 / peak;

@@ -529,7 +529,8 @@ pub(crate) fn not_layered_reason(reason: &NotLayered) -> String {
             format!("only {:.0} % of its surface lies in walls with a facing side", 100.0 * paired_fraction)
         }
         NotLayered::Skins => {
-            "it is no shell (a part faces itself, like a handle or a rod, or its walls' sides do not pair up)"
+            "it is no shell: its surface faces itself across a part (a solid bar or rod, a handle) \
+             instead of a second skin, or its walls' sides do not pair up"
                 .into()
         }
         NotLayered::Column { at } | NotLayered::Fold { at } => {
