@@ -1,12 +1,11 @@
 //! The PNG plot writer: a valid file for real data, a clear error for none.
 
 use modal_study::plot::{write_loglog_png, LogLogPlot, PlotError, Series};
-use std::path::PathBuf;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("modal-study-plot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+/// A directory removed when the test ends (a fixed name under /tmp was left
+/// behind by every run).
+fn scratch() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temp dir")
 }
 
 #[test]
@@ -21,7 +20,8 @@ fn writes_a_png_with_two_series() {
         y_label: "max rel. error",
         series: &series,
     };
-    let path = scratch("two.png");
+    let dir = scratch();
+    let path = dir.path().join("two.png");
     write_loglog_png(&path, &plot).expect("plot written");
     let bytes = std::fs::read(&path).expect("read back");
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
@@ -40,7 +40,8 @@ fn writes_a_png_with_two_series() {
 
 #[test]
 fn rejects_plots_without_positive_data() {
-    let path = scratch("none.png");
+    let dir = scratch();
+    let path = dir.path().join("none.png");
     let empty = LogLogPlot { title: "empty", x_label: "x", y_label: "y", series: &[] };
     let err = write_loglog_png(&path, &empty).unwrap_err();
     assert!(matches!(err, PlotError::NoData { .. }), "{err}");
