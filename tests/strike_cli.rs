@@ -154,6 +154,24 @@ fn a_strike_that_rounds_to_silence_says_so() {
 }
 
 #[test]
+fn a_body_ringing_high_is_struck_with_a_contact_short_enough_to_excite_it() {
+    // The bar made 20 times smaller rings 20 times higher; a fixed 0.1 ms
+    // contact would sit near the half-sine's nulls there.
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    modal(dir.path(), &["retune", "bar.bank", "--scale", "0.05", "-o", "small.bank"]).ok();
+    let low = modal(dir.path(), &["info", "small.bank", "--json"]).ok().json();
+    let f0 = low["modes"][0]["frequency_hz"].as_f64().unwrap();
+    assert!(f0 > 5000.0, "{f0}");
+    let strike = |bank: &str| {
+        let args = ["strike", bank, "-o", "s.wav", "--duration", "0.05", "--json"];
+        modal(dir.path(), &args).ok().json()["contact_time_s"].as_f64().unwrap()
+    };
+    assert!((strike("small.bank") - 0.5 / f0).abs() < 1e-12 * f0.recip());
+    assert_eq!(strike("bar.bank"), 1e-4, "a bar ringing below 5 kHz keeps the 0.1 ms mallet");
+}
+
+#[test]
 fn tables_number_modes_as_json_and_radiation_mode_do() {
     // One numbering everywhere: from 0, as `--json`, `radiation --mode` and
     // every error message count (info and strike's tables counted from 1).

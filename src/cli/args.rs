@@ -355,7 +355,8 @@ pub struct StrikeArgs {
     /// Strike time [s]; one, or one per --at.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub time: Vec<f64>,
-    /// Contact time τ [s] of the half-sine force.
+    /// Contact time τ [s] of the half-sine force. Default: 1e-4 s, or half the period of the bank's
+    /// lowest mode when that is shorter (a body ringing above 5 kHz), so that mode is excited.
     #[arg(long, value_name = "S", conflicts_with = "hertz", allow_negative_numbers = true)]
     pub contact_time: Option<f64>,
     /// Hertz contact of a sphere of MASS_KG and RADIUS_M of the bank's material, striking at the speed

@@ -7,8 +7,8 @@ use anyhow::{bail, ensure, Context, Result};
 use modal_bank::ModeBank;
 use modal_scene::FULL_SCALE_PA;
 use modal_synth::{
-    contact, render_strikes, OutputGain, RenderLength, Strike, SynthModel, SynthOptions, WavFormat, WavGain,
-    DEFAULT_CONTACT_TIME_S,
+    contact, default_contact_time_s, render_strikes, OutputGain, RenderLength, Strike, SynthModel,
+    SynthOptions, WavFormat, WavGain, MIN_FREQUENCY_HZ,
 };
 use serde::Serialize;
 
@@ -90,7 +90,9 @@ fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f
         return Ok(tau);
     }
     let Some([mass_kg, radius_m]) = args.hertz else {
-        return Ok(DEFAULT_CONTACT_TIME_S);
+        let lowest =
+            bank.frequencies_hz.iter().copied().filter(|&f| f >= MIN_FREQUENCY_HZ).fold(f64::NAN, f64::min);
+        return Ok(default_contact_time_s(lowest));
     };
     ensure!(
         (f64::MIN_POSITIVE..=MAX_STRIKER_KG).contains(&mass_kg) && (f64::MIN_POSITIVE..=MAX_STRIKER_M).contains(&radius_m),

@@ -39,7 +39,8 @@ mod wav;
 
 pub use complex::C64;
 pub use contact::{
-    effective_modulus, harmonic, hertz_contact_time, DEFAULT_CONTACT_TIME_S, MAX_CONTACT_TIME_S,
+    default_contact_time_s, effective_modulus, harmonic, hertz_contact_time, DEFAULT_CONTACT_TIME_S,
+    MAX_CONTACT_TIME_S,
 };
 pub use degenerate::degenerate_phases;
 pub use error::SynthError;
