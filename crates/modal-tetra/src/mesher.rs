@@ -12,7 +12,7 @@ use crate::features::{features, snap};
 use crate::geom::{dihedral_angles_deg, orient6, V3};
 use crate::graded::MAX_LEVELS;
 use crate::lattice::Lattice;
-use crate::rescue::{clear, lost, mesh_alone, parts, triangles_outside};
+use crate::rescue::{clear, lost, mesh_alone, parts, specks, specks_warning, triangles_outside, Part};
 use crate::second_try::Smoothed;
 use crate::shell::{layered, LayerSizing, Layered, NotLayered};
 use crate::sizing::{surface_gap, Sizing};
@@ -373,7 +373,10 @@ pub fn tetrahedralize(
     let mut max_surface_deviation_m = deviation(&stuffed.nodes, &boundary, &bvh);
     let mesh_boundary =
         Bvh::new(boundary_faces(&stuffed.tets).into_iter().map(|f| f.map(|v| stuffed.nodes[v])).collect());
-    let kept_triangles = triangles_outside(&repaired, &lost_parts);
+    let specks = specks(&all_parts, &stuffed, diagonal);
+    warnings.extend(specks_warning(&specks));
+    let unmeshed: Vec<&Part> = lost_parts.iter().chain(&specks).copied().collect();
+    let kept_triangles = triangles_outside(&repaired, &unmeshed);
     let (max_surface_gap_m, gap_at) =
         surface_gap(&repaired.vertices, &kept_triangles, &bvh, &mesh_boundary, 0.5 * h0);
     if max_surface_gap_m > GAP_WARNING * diagonal {
