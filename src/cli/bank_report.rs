@@ -159,7 +159,12 @@ impl BankJson {
             Some(method) => {
                 writeln!(out, "error %: estimated discretization error of the frequency ({method})")?
             }
-            None => writeln!(out, "error %: no estimate in this bank (prescribed tet mesh or older bank)")?,
+            // A bank with no mode in its band has nothing to estimate.
+            None if self.modes.is_empty() => {}
+            None => writeln!(
+                out,
+                "error %: no estimate in this bank (prescribed tet mesh, --accuracy off or older bank)"
+            )?,
         }
         let t = &self.timings_s;
         writeln!(
