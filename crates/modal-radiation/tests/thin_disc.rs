@@ -1,0 +1,77 @@
+//! A thin rigid disc translating along its axis (broadside): at low `ka`
+//! a dipole whose strength is the disc's added mass, `(8/3) ρ₀ a³` for a
+//! disc of no thickness (Lamb, *Hydrodynamics* §108), plus its volume
+//! `π a² t`: `|p| = ρ₀ c k² ((8/3) a³ + π a² t) U cos θ / (4π r)` far away.
+//! It probes what a thin wall does to the solver (the two faces a wall
+//! thickness apart, panels wider than that).
+
+use faer::c64;
+use modal_radiation::{solve, Air, BoundaryMesh, Formulation};
+
+/// A closed disc of radius `a` and thickness `t` about the origin: `rings`
+/// rings of `segments` on each face and one band of quads around the rim.
+fn disc(a: f64, t: f64, rings: usize, segments: usize) -> BoundaryMesh {
+    let mut v = Vec::new();
+    let mut tris = Vec::new();
+    let mut face = |z: f64, up: bool, v: &mut Vec<[f64; 3]>| -> Vec<usize> {
+        let centre = v.len();
+        v.push([0.0, 0.0, z]);
+        let at = |r: usize, s: usize| centre + 1 + (r - 1) * segments + s % segments;
+        for r in 1..=rings {
+            let rho = a * r as f64 / rings as f64;
+            for s in 0..segments {
+                let phi = 2.0 * std::f64::consts::PI * (s as f64 + 0.5 * (r % 2) as f64) / segments as f64;
+                v.push([rho * phi.cos(), rho * phi.sin(), z]);
+            }
+        }
+        let mut push = |a: usize, b: usize, c: usize| tris.push(if up { [a, b, c] } else { [a, c, b] });
+        for s in 0..segments {
+            push(centre, at(1, s), at(1, s + 1));
+        }
+        for r in 1..rings {
+            for s in 0..segments {
+                push(at(r, s), at(r + 1, s), at(r + 1, s + 1));
+                push(at(r, s), at(r + 1, s + 1), at(r, s + 1));
+            }
+        }
+        (0..segments).map(|s| at(rings, s)).collect()
+    };
+    let top = face(0.5 * t, true, &mut v);
+    let bottom = face(-0.5 * t, false, &mut v);
+    for s in 0..segments {
+        let (a0, a1, b0, b1) = (top[s], top[(s + 1) % segments], bottom[s], bottom[(s + 1) % segments]);
+        tris.push([b0, a1, a0]);
+        tris.push([b0, b1, a1]);
+    }
+    BoundaryMesh::new(v, &tris).unwrap()
+}
+
+#[test]
+fn a_thin_rigid_disc_translating_broadside_radiates_its_added_mass_dipole() {
+    // Measured (level error on the axis and at θ = 0.6, the same to 0.03 dB):
+    // 1 536 panels 1.14 dB, 3 072 panels 0.90 dB, 6 144 panels 0.55 dB: panels
+    // 2.5–5 times wider than the wall cost about half a dB, falling as they shrink.
+    let (a, t, f) = (0.1, 0.002, 100.0);
+    let air = Air::default();
+    let k = 2.0 * std::f64::consts::PI * f / air.sound_speed_m_s;
+    let strength = 8.0 / 3.0 * a * a * a + std::f64::consts::PI * a * a * t;
+    let errors = |rings: usize, segments: usize| -> Vec<f64> {
+        let mesh = disc(a, t, rings, segments);
+        let v: Vec<c64> = mesh.panels.iter().map(|p| c64::new(p.normal[2], 0.0)).collect();
+        let s = solve(&mesh, air, f, &[v], Formulation::BurtonMiller).unwrap().remove(0);
+        [0.0f64, 0.6]
+            .iter()
+            .map(|&theta| {
+                let x = [theta.sin(), 0.0, theta.cos()];
+                let want = air.density_kg_m3 * air.sound_speed_m_s * k * k * strength * theta.cos()
+                    / (4.0 * std::f64::consts::PI);
+                20.0 * (s.pressure_at(&mesh, x).unwrap().norm() / want).log10()
+            })
+            .collect()
+    };
+    let (coarse, fine) = (errors(8, 48), errors(16, 96));
+    for (c, f) in coarse.iter().zip(&fine) {
+        assert!(f.abs() < 0.7, "6 144 panels: {f:.3} dB");
+        assert!(f.abs() < 0.7 * c.abs(), "no closer on a finer mesh: {c:.3} then {f:.3} dB");
+    }
+}
