@@ -107,8 +107,9 @@ const MEMORY_MARGIN: f64 = 1.25;
 /// [`MEMORY_RETRIES`] times: the defaults must give an answer, not a refusal after a
 /// minute of meshing (a glass of 1.5 mm wall on a stem: 1.9 M DOF, a 32 GB factor). The
 /// factor comes from the overrun by the module doc's model, memory ∝ s⁻⁴, with
-/// [`MEMORY_MARGIN`], then by the exponent the refusals measure ([`memory_exponent`]). Returns the result and the level it was solved at; the warning
-/// says what was coarsened and why.
+/// [`MEMORY_MARGIN`], then by the exponent the refusals measure ([`memory_exponent`]).
+/// Returns the result and the level it was solved at; the warning says what was
+/// coarsened and why.
 pub(crate) fn within_memory<T>(
     request: &Request,
     warnings: &mut Vec<String>,

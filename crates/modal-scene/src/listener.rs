@@ -3,10 +3,12 @@
 //!
 //! `s` is the object's radiated signal (emission time), `p` the object's
 //! centre of mass, `c` = [`SPEED_OF_SOUND_M_S`]. The sound heard at `t` left
-//! the body where it was at `t − τ` (Liénard–Wiechert's retarded time), so a
-//! receding source is heard at `f / (1 + v/c)`, not at the moving observer's
-//! `f (1 − v/c)`; `τ` is found by [`RETARDATION_STEPS`] fixed-point steps
-//! from the distance at `t`, each shrinking the error by `v/c`.
+//! the body where it was at the retarded time `t − τ`, so a receding source
+//! is heard at `f / (1 + v/c)`, not at the moving observer's `f (1 − v/c)`;
+//! `τ` is found by [`RETARDATION_STEPS`] fixed-point steps from the distance
+//! at `t`, each shrinking the error by `v/c` (a body faster than sound, up to
+//! the scene's 1 km/s, gets a distance it held during the last steps: finite,
+//! not the retarded one).
 //! Gain and delay are evaluated at the edges of blocks of [`BLOCK`] samples
 //! from the physics trajectory (linear between physics steps) and linearly
 //! interpolated inside a block, so moving bodies glide without zipper noise.
