@@ -32,7 +32,9 @@ pub struct RadiationArgs {
     /// Only these modes (indices into the bank; repeatable); default: every audible mode.
     #[arg(long, value_name = "I")]
     pub mode: Vec<usize>,
-    /// Solve every mode on the full panel mesh (no coarser panels or pressure clusters).
+    /// Solve every mode on the full panel mesh (no coarser panels or pressure clusters; up to 32 000
+    /// panels, slower): the accurate setting for thin flat walls (plates, discs) whose default
+    /// clusters are wider than the wall (docs/radiation.md).
     #[arg(long)]
     pub full_resolution: bool,
     /// Pressure cluster size κ: clusters of diameter κ / max(k, k_s), k the

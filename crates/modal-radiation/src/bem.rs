@@ -330,7 +330,11 @@ pub fn solve_on(
                     .map(|p| (p, SolverPath::Lu { after_gmres: compressed || iterative }))
             })
         })
-        .ok_or(RadiationError::Singular { frequency_hz })?;
+        .ok_or(if clusters.len() > MAX_DENSE_UNKNOWNS {
+            RadiationError::NotConverged { frequency_hz, unknowns: clusters.len(), max: MAX_DENSE_UNKNOWNS }
+        } else {
+            RadiationError::Singular { frequency_hz }
+        })?;
     let fields = (0..nrhs)
         .map(|f| SurfaceField {
             frequency_hz,

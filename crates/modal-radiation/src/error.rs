@@ -117,6 +117,20 @@ pub enum RadiationError {
         /// Frequency [Hz].
         frequency_hz: f64,
     },
+    /// GMRES did not converge on a system too large for the dense fallback
+    /// (a full-resolution solve above [`crate::modes::MAX_DENSE_PANELS`]).
+    #[error(
+        "the boundary-element system at {frequency_hz} Hz ({unknowns} unknowns) did not converge, and is too \
+         large for the dense solve ({max}): drop --full-resolution"
+    )]
+    NotConverged {
+        /// Frequency [Hz].
+        frequency_hz: f64,
+        /// Unknowns of the system.
+        unknowns: usize,
+        /// The dense solve's limit.
+        max: usize,
+    },
     /// The surface has more panels than a solve with one unknown per panel takes.
     #[error(
         "the surface has {panels} panels, more than the {max} unknowns a full-resolution solve takes: drop \

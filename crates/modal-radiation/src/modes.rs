@@ -367,6 +367,16 @@ pub const MAX_CLUSTER_RADIUS_FRACTION: f64 = 0.5;
 /// [`Progress::under_resolved`]).
 pub const MAX_DENSE_PANELS: usize = crate::bem::MAX_DENSE_UNKNOWNS;
 
+/// Most panels of a solve with one unknown per panel (`adaptive_resolution`
+/// off, the CLI's `--full-resolution`): asked for, it is solved compressed
+/// above [`MAX_DENSE_PANELS`], without the dense fallback (a GMRES that does
+/// not converge there is an error, [`RadiationError::NotConverged`]). A thin
+/// wall needs unknowns about a wall thickness wide: a free disc 20 cm × 2 mm
+/// on its 31 360-panel split took 13–16 s a mode and 1.5 GB below 2 kHz, and
+/// agreed with bempp-cl where the default did not (BENCHMARKS.md, "A thin disc
+/// against bempp-cl").
+pub const MAX_FULL_RESOLUTION_PANELS: usize = 32_000;
+
 /// One panel level of a bank: panels, their adjacency, their near field
 /// (integrated when the level is first solved on), and how to get a mode's
 /// normal velocity on them.
@@ -527,8 +537,9 @@ fn plan<'a>(
         _ => &panels.fine,
     };
     if !opts.adaptive_resolution {
-        if level.mesh.len() > MAX_DENSE_PANELS {
-            return Err(RadiationError::TooManyPanels { panels: level.mesh.len(), max: MAX_DENSE_PANELS });
+        if level.mesh.len() > MAX_FULL_RESOLUTION_PANELS {
+            let max = MAX_FULL_RESOLUTION_PANELS;
+            return Err(RadiationError::TooManyPanels { panels: level.mesh.len(), max });
         }
         let clusters = Clusters::identity(level.mesh.len());
         return Ok(Plan { level, clusters, under_resolved: k * level.h > UNDER_RESOLVED_KH, k_eff });

@@ -105,6 +105,20 @@ fn oscillating_rigid_sphere_matches_the_closed_form() {
 }
 
 #[test]
+fn one_unknown_per_panel_above_the_dense_limit_is_solved_compressed() {
+    // 20 480 panels, more than the dense solve takes (the fallback of every
+    // default solve): what `--full-resolution` asks on a thin wall's split.
+    let mesh = sphere(5);
+    assert!(mesh.len() > modal_radiation::bem::MAX_DENSE_UNKNOWNS);
+    let c = (4.0 * std::f64::consts::PI / 3.0).sqrt();
+    let ka = 1.0;
+    let v = mesh.panels.iter().map(|p| c64::new(p.normal[2], 0.0)).collect();
+    let s = solve_one(&mesh, ka, v, Formulation::BurtonMiller);
+    let (level, phase) = errors(&mesh, &s, 2.5 * A, |x| exact(1, &[(0, c64::new(c, 0.0))], ka, x));
+    assert!(level < 0.05 && phase < 0.01, "{level} dB, {phase} rad");
+}
+
+#[test]
 fn fictitious_frequency_ka_pi_is_solved_by_burton_miller_and_not_by_the_cbie() {
     let mesh = sphere(3);
     let y00 = 1.0 / (4.0 * std::f64::consts::PI).sqrt();
