@@ -270,19 +270,17 @@ fn scenes_at_44_1_and_48_khz_share_one_bank() {
 }
 
 #[test]
-fn a_scene_with_nothing_to_sound_says_so() {
+fn a_silent_scene_and_ears_metres_apart_are_warned_about() {
+    // Nothing to sound; and `ear_spacing = 50` meant as centimetres (two
+    // microphones 50 m apart).
     let dir = temp_dir();
-    std::fs::write(dir.path().join("empty.toml"), "duration = 0.1\n").unwrap();
-    let run = modal(dir.path(), &["render", "empty.toml", "-o", "e.wav"]).ok();
-    assert!(run.stderr.contains("no object and no sounding ground: the WAV is silence"), "{}", run.stderr);
-    assert!(!run.stderr.contains("ear_spacing"), "{}", run.stderr);
-}
-
-#[test]
-fn ears_metres_apart_are_warned_about() {
-    // `ear_spacing = 50` meant as centimetres: two microphones 50 m apart.
-    let dir = temp_dir();
-    std::fs::write(dir.path().join("wide.toml"), "duration = 0.1\n[listener]\near_spacing = 50\n").unwrap();
-    let run = modal(dir.path(), &["render", "wide.toml", "-o", "w.wav"]).ok();
-    assert!(run.stderr.contains("ear_spacing = 50 m puts the ears 50 m apart"), "{}", run.stderr);
+    let warnings = |scene: &str| {
+        std::fs::write(dir.path().join("s.toml"), scene).unwrap();
+        modal(dir.path(), &["render", "s.toml", "-o", "s.wav"]).ok().stderr
+    };
+    let empty = warnings("duration = 0.1\n");
+    assert!(empty.contains("no object and no sounding ground: the WAV is silence"), "{empty}");
+    assert!(!empty.contains("ear_spacing"), "{empty}");
+    let wide = warnings("duration = 0.1\n[listener]\near_spacing = 50\n");
+    assert!(wide.contains("ear_spacing = 50 m puts the ears 50 m apart"), "{wide}");
 }
