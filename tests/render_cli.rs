@@ -283,4 +283,6 @@ fn a_silent_scene_and_ears_metres_apart_are_warned_about() {
     assert!(!empty.contains("ear_spacing"), "{empty}");
     let wide = warnings("duration = 0.1\n[listener]\near_spacing = 50\n");
     assert!(wide.contains("ear_spacing = 50 m puts the ears 50 m apart"), "{wide}");
+    let mono = warnings("duration = 0.1\n[listener]\nchannels = \"mono\"\near_spacing = 50\n");
+    assert!(!mono.contains("ear_spacing"), "one point has no spacing: {mono}");
 }

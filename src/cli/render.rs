@@ -606,7 +606,8 @@ fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<S
         ));
     }
     let spacing = scene.listener.ear_spacing_m;
-    if spacing > MAX_HEAD_EAR_SPACING_M {
+    // A mono listener is one point: its spacing is not used.
+    if scene.listener.channels == modal_scene::Channels::Stereo && spacing > MAX_HEAD_EAR_SPACING_M {
         // A unit slip (50 meant as cm) would otherwise pass silently: the
         // channels would be two microphones 50 m apart, 146 ms out of step.
         warnings.push(format!(
