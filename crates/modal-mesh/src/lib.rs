@@ -36,6 +36,7 @@ mod parts;
 mod promote;
 mod quality;
 mod surface;
+mod triangle6;
 mod types;
 mod units;
 mod validate;
@@ -53,6 +54,7 @@ pub use parts::{describe_hinges, face_parts, split_hinges, FaceParts, Hinge};
 pub use promote::{to_linear, to_quadratic, to_quadratic_with};
 pub use quality::{dihedral_angles_deg, min_dihedral_angle_deg};
 pub use surface::boundary_surface;
+pub use triangle6::quadratic_triangle_normal;
 pub use types::*;
 pub use units::{
     bounding_box, bounding_diagonal, readable, scale_refusal, unit_warning, unstated_size_refusal,

@@ -130,7 +130,7 @@ impl Triangles {
             .map(|n| {
                 let x = n.map(|i| positions[i]);
                 if edge_nodes.is_some() {
-                    REFERENCE_NODES.map(|(xi, eta)| quadratic_normal(&x, xi, eta))
+                    REFERENCE_NODES.map(|(xi, eta)| modal_mesh::quadratic_triangle_normal(&x, xi, eta))
                 } else {
                     [cross(sub(x[1], x[0]), sub(x[2], x[0])); 6]
                 }
@@ -154,24 +154,6 @@ impl Triangles {
 /// Reference coordinates `(ξ, η)` of the six nodes of a quadratic triangle.
 const REFERENCE_NODES: [(f64, f64); 6] =
     [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
-
-/// `∂x/∂ξ × ∂x/∂η` of the 6-node triangle (corners 0–2, mid-edge nodes of
-/// edges 01, 12, 20) at `(ξ, η)`: the normal scaled by twice the local area
-/// element.
-pub(crate) fn quadratic_normal(x: &[[f64; 3]; 6], xi: f64, eta: f64) -> [f64; 3] {
-    let l0 = 1.0 - xi - eta;
-    let d_xi = [-(4.0 * l0 - 1.0), 4.0 * xi - 1.0, 0.0, 4.0 * (l0 - xi), 4.0 * eta, -4.0 * eta];
-    let d_eta = [-(4.0 * l0 - 1.0), 0.0, 4.0 * eta - 1.0, -4.0 * xi, 4.0 * xi, 4.0 * (l0 - eta)];
-    let mut a = [0.0; 3];
-    let mut b = [0.0; 3];
-    for k in 0..6 {
-        for q in 0..3 {
-            a[q] += d_xi[k] * x[k][q];
-            b[q] += d_eta[k] * x[k][q];
-        }
-    }
-    cross(a, b)
-}
 
 /// The smooth sectors around every node.
 struct Sectors {

@@ -334,7 +334,12 @@ fn on_sub_triangles(surface: &Surface, edges: [usize; 3], flat: SurfacePoint, p:
         }
     }
     let x = nodes.map(|n| surface.positions[n]);
-    let curved = if evenly_curved(&x) { curved_normal(x, best.bary) } else { [0.0; 3] };
+    // The curved surface's own normal at the point, not a facet's (ξ = λ₁, η = λ₂).
+    let curved = if evenly_curved(&x) {
+        normalized(modal_mesh::quadratic_triangle_normal(&x, best.bary[1], best.bary[2]))
+    } else {
+        [0.0; 3]
+    };
     best.normal = if curved == [0.0; 3] { flat.normal } else { curved };
     best
 }
@@ -352,16 +357,6 @@ fn evenly_curved(x: &[V3; 6]) -> bool {
         dot(off, off).sqrt() > 1e-6 * dot(chord, chord).sqrt()
     });
     bows.iter().all(|&b| b) || bows.iter().all(|&b| !b)
-}
-
-/// Unit normal `x_ξ × x_η` of the 6-node triangle with nodes `x` (corners,
-/// then mid-edge nodes of (0,1), (1,2), (2,0)) at barycentric `[λ₀, λ₁, λ₂]`
-/// (`ξ = λ₁`, `η = λ₂`): the curved surface's own normal, not a facet's.
-fn curved_normal(x: [V3; 6], [l0, l1, l2]: V3) -> V3 {
-    let d_xi = [1.0 - 4.0 * l0, 4.0 * l1 - 1.0, 0.0, 4.0 * (l0 - l1), 4.0 * l2, -4.0 * l2];
-    let d_eta = [1.0 - 4.0 * l0, 0.0, 4.0 * l2 - 1.0, -4.0 * l1, 4.0 * l1, 4.0 * (l0 - l2)];
-    let along = |d: [f64; 6]| [0, 1, 2].map(|c| (0..6).map(|k| d[k] * x[k][c]).sum::<f64>());
-    normalized(cross(along(d_xi), along(d_eta)))
 }
 
 #[cfg(test)]
