@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{modal, temp_dir};
+use common::{modal, modal_within_memory, temp_dir};
 use modal_bank::ModeBank;
 use modal_radiation::c64;
 use modal_radiation::modes::{boundary_mesh, normal_velocity};
@@ -609,6 +609,13 @@ fn coarse_panels_at_low_frequency_agree_with_the_full_resolution() {
         let (pa, pb) = (a["radiated_power_w"].as_f64().unwrap(), b["radiated_power_w"].as_f64().unwrap());
         assert!((10.0 * (pa / pb).log10()).abs() < 0.5, "power {pa} vs {pb}");
     }
+    // Beyond the memory guard a solve is refused with the limit, not run
+    // until the machine runs out (a full-resolution solve can need GBs).
+    let mut tight = vec!["radiation", "soft.bank", "--point", "0.2,0.1,-0.12", "--mode", "5", "--json"];
+    tight.push("--full-resolution");
+    let refused = modal_within_memory(dir.path(), &tight, "0.001").fails_with("memory limit of 0.00 GB");
+    assert!(refused.stderr.contains("drop --full-resolution"), "{}", refused.stderr);
+    assert!(refused.json()["error"].is_string(), "{}", refused.stdout);
 }
 
 /// Exactly tangential fields on the FEM sphere's curved surface must stay

@@ -154,7 +154,11 @@ pub fn listener_gains(
         return Ok(heard.from(TransferSource::Stored));
     }
     if solve {
-        let opts = RadiationOptions { air: Air::default(), ..RadiationOptions::default() };
+        let opts = RadiationOptions {
+            air: Air::default(),
+            memory_limit_bytes: super::precompute::memory_guard_bytes()?,
+            ..RadiationOptions::default()
+        };
         let started = std::time::Instant::now();
         let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &audible, &opts, &mut |p| {
             eprintln!("{p}")

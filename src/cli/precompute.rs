@@ -66,6 +66,12 @@ pub fn memory_limit_from_env() -> Result<Option<u64>> {
     }
 }
 
+/// The memory guard [bytes]: [`MEMORY_LIMIT_ENV`] if set, else 75 % of the
+/// available memory (`None` where that is unknown).
+pub fn memory_guard_bytes() -> Result<Option<u64>> {
+    Ok(memory_limit_from_env()?.or_else(modal_eigen::default_memory_limit))
+}
+
 /// The cache the flags ask for (none with `--no-cache`). A path that exists
 /// and is not a directory is refused at once: every asset of a batch would
 /// otherwise report it as "a damaged cache entry".

@@ -150,6 +150,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         air,
         adaptive_resolution: !args.full_resolution,
         cluster_kh: args.cluster_kh,
+        memory_limit_bytes: super::precompute::memory_guard_bytes()?,
         ..RadiationOptions::default()
     };
     let results =

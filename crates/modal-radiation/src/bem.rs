@@ -44,7 +44,7 @@ use crate::batch::{Formula, SourcePoints};
 use crate::cluster::Clusters;
 use crate::error::RadiationError;
 use crate::geometry::BoundaryMesh;
-use crate::hmatrix::HMatrix;
+use crate::hmatrix::{HMatrix, OverBudget};
 use crate::kernels::{CoupledKernels, Kernels};
 use crate::near::NearField;
 use crate::precond::BlockJacobi;
@@ -238,7 +238,7 @@ pub fn solve_clustered(
     formulation: Formulation,
 ) -> Result<Vec<SurfaceField>, RadiationError> {
     let near = NearField::new(mesh);
-    let disc = Discretization { mesh, near: &near, clusters, aggregate: true };
+    let disc = Discretization { mesh, near: &near, clusters, aggregate: true, memory_limit_bytes: None };
     solve_on(&disc, air, frequency_hz, velocities, formulation).map(|(fields, _)| fields)
 }
 
@@ -254,6 +254,10 @@ pub struct Discretization<'a> {
     /// Sum far clusters as points ([`crate::assembly`]); off, every panel is
     /// integrated on its own (the reference of the error measurements).
     pub aggregate: bool,
+    /// Most bytes the system's matrix and the near field may hold together;
+    /// beyond it the solve is refused ([`RadiationError::OutOfMemory`])
+    /// rather than exhaust the machine. `None`: no limit.
+    pub memory_limit_bytes: Option<u64>,
 }
 
 /// How a system was solved (for progress reports: a fallback is slow).
@@ -317,7 +321,27 @@ pub fn solve_on(
     let kern = Kernels::new(k);
     let asm = Assembly::new(mesh, disc.near, clusters, &kern, alpha, &q, disc.aggregate);
     let compressed = clusters.len() >= HMATRIX_MIN_UNKNOWNS;
-    let (pressures, path) = if compressed { compressed_solve(&asm) } else { None }
+    // The matrix's share of the memory guard: what the near field leaves.
+    let budget = disc.memory_limit_bytes.map_or(usize::MAX, |limit| {
+        usize::try_from(limit).unwrap_or(usize::MAX).saturating_sub(disc.near.bytes())
+    });
+    let out_of_memory = |needed_bytes: usize| RadiationError::OutOfMemory {
+        frequency_hz,
+        unknowns: clusters.len(),
+        needed_bytes: needed_bytes.saturating_add(disc.near.bytes()) as u64,
+        limit_bytes: disc.memory_limit_bytes.unwrap_or(u64::MAX),
+    };
+    let solved = if compressed {
+        compressed_solve(&asm, budget).map_err(|over| out_of_memory(over.stored_bytes))?
+    } else {
+        None
+    };
+    let dense_bytes =
+        clusters.len().saturating_mul(clusters.len()).saturating_mul(std::mem::size_of::<c64>());
+    if solved.is_none() && clusters.len() <= MAX_DENSE_UNKNOWNS && dense_bytes > budget {
+        return Err(out_of_memory(dense_bytes));
+    }
+    let (pressures, path) = solved
         .map(|(p, it)| (p, SolverPath::CompressedGmres(it)))
         .or_else(|| {
             if clusters.len() > MAX_DENSE_UNKNOWNS {
@@ -374,11 +398,15 @@ pub const MAX_DENSE_UNKNOWNS: usize = 6000;
 /// The compressed system solved by GMRES ([`crate::gmres::solve_many`],
 /// all fields at once), preconditioned by the diagonal blocks of the
 /// cluster tree's leaves ([`crate::precond`]); `None` when a block is
-/// singular or any field does not converge.
-fn compressed_solve(asm: &Assembly<'_>) -> Option<(Mat<c64>, usize)> {
-    let (h, rhs) = HMatrix::assemble(asm);
-    let pc = BlockJacobi::new(asm.len(), h.diagonal_blocks().map(|(u, d)| (u, d.to_vec())))?;
-    gmres_solve(&pc, &|xs: &[&[c64]], ys: &mut [Vec<c64>]| h.apply_many(xs, ys), &rhs, asm.fields().len())
+/// singular or any field does not converge; an error when the matrix
+/// holds more than `budget` bytes.
+fn compressed_solve(asm: &Assembly<'_>, budget: usize) -> Result<Option<(Mat<c64>, usize)>, OverBudget> {
+    let (h, rhs) = HMatrix::assemble_within(asm, budget)?;
+    let Some(pc) = BlockJacobi::new(asm.len(), h.diagonal_blocks().map(|(u, d)| (u, d.to_vec()))) else {
+        return Ok(None);
+    };
+    let apply = |xs: &[&[c64]], ys: &mut [Vec<c64>]| h.apply_many(xs, ys);
+    Ok(gmres_solve(&pc, &apply, &rhs, asm.fields().len()))
 }
 
 /// GMRES on the dense system (`a` = `A` row-major, which the assembly's
@@ -480,7 +508,13 @@ mod tests {
             let clusters = Clusters::grow(&mesh, &Adjacency::new(&mesh), (0.5 / k).min(0.025));
             assert!(clusters.len() < mesh.len() / 2, "{} clusters", clusters.len());
             let field = |aggregate| {
-                let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate };
+                let disc = Discretization {
+                    mesh: &mesh,
+                    near: &near,
+                    clusters: &clusters,
+                    aggregate,
+                    memory_limit_bytes: None,
+                };
                 solve_on(&disc, air, f, std::slice::from_ref(&vel), Formulation::BurtonMiller)
                     .unwrap()
                     .0
@@ -535,7 +569,13 @@ mod tests {
             let mesh = crate::geometry::tests::ellipsoid([0.1, 0.07, 0.05], subdivisions);
             let vel: Vec<c64> = mesh.panels.iter().map(|p| c64::new(p.normal[0], 0.0)).collect();
             let (near, clusters) = (NearField::new(&mesh), Clusters::identity(mesh.len()));
-            let disc = Discretization { mesh: &mesh, near: &near, clusters: &clusters, aggregate: true };
+            let disc = Discretization {
+                mesh: &mesh,
+                near: &near,
+                clusters: &clusters,
+                aggregate: true,
+                memory_limit_bytes: None,
+            };
             let (fields, path) =
                 solve_on(&disc, air, 1000.0, std::slice::from_ref(&vel), Formulation::BurtonMiller).unwrap();
             assert_eq!(fields.len(), 1);
@@ -550,6 +590,44 @@ mod tests {
         assert!((ITERATIVE_MIN_UNKNOWNS..HMATRIX_MIN_UNKNOWNS).contains(&n), "{n}");
         assert!(matches!(large, SolverPath::DenseGmres(it) if it > 0), "{large:?}");
         assert_eq!(SolverPath::Lu { after_gmres: true }.to_string(), "dense LU after GMRES did not converge");
+    }
+
+    /// A solve beyond the memory guard is refused, dense or compressed,
+    /// with the frequency, the unknowns and the limit; within it, the same
+    /// bits as with no guard.
+    #[test]
+    fn a_system_beyond_the_memory_limit_is_refused() {
+        let mesh = crate::geometry::tests::ellipsoid([0.1, 0.07, 0.05], 2);
+        let vel: Vec<c64> = mesh.panels.iter().map(|p| c64::new(p.normal[0], 0.0)).collect();
+        let (near, clusters) = (NearField::new(&mesh), Clusters::identity(mesh.len()));
+        let solve_within = |memory_limit_bytes| {
+            let disc = Discretization {
+                mesh: &mesh,
+                near: &near,
+                clusters: &clusters,
+                aggregate: true,
+                memory_limit_bytes,
+            };
+            solve_on(&disc, Air::default(), 1000.0, std::slice::from_ref(&vel), Formulation::BurtonMiller)
+        };
+        let n = mesh.len();
+        // The dense matrix (16 B an entry) and the near field fit exactly.
+        let needed = (16 * n * n + near.bytes()) as u64;
+        let err = solve_within(Some(needed - 1)).expect_err("one byte short");
+        assert!(
+            matches!(err, RadiationError::OutOfMemory { unknowns, limit_bytes, .. }
+                if unknowns == n && limit_bytes == needed - 1),
+            "{err:?}"
+        );
+        let said = err.to_string();
+        assert!(said.starts_with("the boundary-element system at 1000 Hz (320 unknowns)"), "{said}");
+        assert!(said.contains("memory limit of 0.00 GB") && said.contains("--full-resolution"), "{said}");
+        let free = solve_within(None).unwrap();
+        assert!(solve_within(Some(needed)).unwrap() == free, "the guard changed the solve");
+        // The compressed path: refused inside its assembly.
+        let system = crate::hmatrix::system_tests::EllipsoidSystem::new();
+        let asm = system.assembly();
+        assert!(matches!(compressed_solve(&asm, 1 << 20), Err(over) if over.stored_bytes > 1 << 20));
     }
 
     #[test]
@@ -587,7 +665,7 @@ mod tests {
         let asm = system.assembly();
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| compressed_solve(&asm).expect("GMRES converges"))
+            pool.install(|| compressed_solve(&asm, usize::MAX).expect("no budget").expect("GMRES converges"))
         };
         let (it, iterations) = on(1);
         assert!(iterations > 0);

@@ -131,6 +131,24 @@ pub enum RadiationError {
         /// The dense solve's limit.
         max: usize,
     },
+    /// The system would hold more memory than the guard allows
+    /// ([`crate::modes::RadiationOptions::memory_limit_bytes`]).
+    #[error(
+        "the boundary-element system at {frequency_hz:.0} Hz ({unknowns} unknowns) needs more than the memory \
+         limit of {:.2} GB (MODAL_MEMORY_LIMIT_GB, or 75 % of the available memory): drop --full-resolution, \
+         or solve the lower modes only (--max-freq)",
+        *limit_bytes as f64 / 1e9
+    )]
+    OutOfMemory {
+        /// Frequency [Hz].
+        frequency_hz: f64,
+        /// Unknowns of the system.
+        unknowns: usize,
+        /// Bytes held when the solve stopped (a lower bound of the need).
+        needed_bytes: u64,
+        /// The limit [bytes].
+        limit_bytes: u64,
+    },
     /// The surface has more panels than a solve with one unknown per panel takes.
     #[error(
         "the surface has {panels} panels, more than the {max} unknowns a full-resolution solve takes: drop \

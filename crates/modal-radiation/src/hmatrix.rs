@@ -59,6 +59,7 @@
 
 use faer::c64;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::assembly::Assembly;
 
@@ -182,12 +183,31 @@ impl ClusterTree {
     }
 }
 
+/// A compressed assembly stopped at its memory budget
+/// ([`HMatrix::assemble_within`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct OverBudget {
+    /// Bytes the blocks built so far hold (more than the budget).
+    pub(crate) stored_bytes: usize,
+}
+
 /// The stored part of one block of `A`.
 pub(crate) enum Data {
     /// `m × n_σ`, row-major.
     Dense(Vec<c64>),
     /// `U` (`r` columns of length `m`) and `W = Vᵀ` (`r` rows of length `n_σ`).
     LowRank { u: Vec<Vec<c64>>, w: Vec<Vec<c64>> },
+}
+
+impl Data {
+    /// Memory held [bytes].
+    fn bytes(&self) -> usize {
+        let entries = match self {
+            Data::Dense(d) => d.len(),
+            Data::LowRank { u, w } => u.iter().chain(w).map(Vec::len).sum(),
+        };
+        entries * std::mem::size_of::<c64>()
+    }
 }
 
 struct Block {
@@ -221,24 +241,51 @@ pub struct HStats {
 
 impl HMatrix {
     /// The compressed `A` and the right-hand sides (row-major `n × nrhs`)
-    /// of an assembly.
+    /// of an assembly, with no memory budget.
+    #[cfg(test)]
     pub(crate) fn assemble(asm: &Assembly<'_>) -> (HMatrix, Vec<c64>) {
+        match HMatrix::assemble_within(asm, usize::MAX) {
+            Ok(built) => built,
+            Err(_) => unreachable!("no block list holds more than usize::MAX bytes"),
+        }
+    }
+
+    /// [`HMatrix::assemble`], refused once the blocks hold more than
+    /// `budget` bytes: the error carries the bytes stored when it was
+    /// crossed. The blocks are built in parallel and each adds its bytes
+    /// when done; later blocks are skipped once the sum is over. Whether
+    /// the sum crosses the budget does not depend on the order (the total
+    /// does not), so neither does the outcome.
+    pub(crate) fn assemble_within(
+        asm: &Assembly<'_>,
+        budget: usize,
+    ) -> Result<(HMatrix, Vec<c64>), OverBudget> {
         let n = asm.len();
         let nrhs = asm.fields().len();
         let zero = c64::new(0.0, 0.0);
         let bounds: Vec<Bounds> = (0..n).map(|c| asm.bounds(c)).collect();
         let tree = ClusterTree::new(&bounds);
         let perm = tree.perm.clone();
-        let built: Vec<(Block, Vec<c64>)> = tree
+        let stored = AtomicUsize::new(0);
+        let built: Vec<Option<(Block, Vec<c64>)>> = tree
             .blocks()
             .into_par_iter()
             .map(|(t, s, admissible)| {
+                if stored.load(Ordering::Relaxed) > budget {
+                    return None;
+                }
                 let (nt, ns) = (&tree.nodes[t], &tree.nodes[s]);
                 let (rows, cols) = (&perm[nt.start..nt.end], &perm[ns.start..ns.end]);
                 let (data, rhs) = crate::aca::block(asm, rows, cols, admissible);
-                (Block { rows: (nt.start, nt.end), cols: (ns.start, ns.end), data }, rhs)
+                stored.fetch_add(data.bytes(), Ordering::Relaxed);
+                Some((Block { rows: (nt.start, nt.end), cols: (ns.start, ns.end), data }, rhs))
             })
             .collect();
+        let stored = stored.into_inner();
+        if stored > budget {
+            return Err(OverBudget { stored_bytes: stored });
+        }
+        let built = built.into_iter().map(|b| b.expect("no block is skipped within the budget"));
         let mut rhs = vec![zero; n * nrhs];
         let mut diagonal = vec![zero; n];
         let mut blocks = Vec::with_capacity(built.len());
@@ -266,7 +313,7 @@ impl HMatrix {
             });
             groups[g].push(i);
         }
-        (HMatrix { perm, blocks, groups, diagonal }, rhs)
+        Ok((HMatrix { perm, blocks, groups, diagonal }, rhs))
     }
 
     /// Number of unknowns.
@@ -517,5 +564,23 @@ pub(crate) mod system_tests {
             })
         };
         assert!(on(1) == on(3), "thread count changed the compressed system");
+    }
+
+    /// The budget refuses exactly the assemblies that hold more than it,
+    /// on any thread count (the outcome follows the total, not the order).
+    #[test]
+    fn a_budget_one_byte_short_of_the_matrix_refuses_it_on_any_thread_count() {
+        let system = EllipsoidSystem::new();
+        let asm = system.assembly();
+        let total = HMatrix::assemble(&asm).0.bytes();
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let over = HMatrix::assemble_within(&asm, total - 1).err().expect("one byte short");
+                assert!(over.stored_bytes > total - 1 && over.stored_bytes <= total, "{over:?}, {total}");
+                let Ok((h, _)) = HMatrix::assemble_within(&asm, total) else { panic!("fits exactly") };
+                assert_eq!(h.bytes(), total);
+            });
+        }
     }
 }

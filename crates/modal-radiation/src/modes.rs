@@ -44,6 +44,12 @@ pub struct RadiationOptions {
     pub adaptive_resolution: bool,
     /// `κ`: cluster diameter `κ / max(k, k_s)` (smaller is finer and dearer).
     pub cluster_kh: f64,
+    /// Most bytes one solve's matrix and near field may hold
+    /// ([`crate::bem::Discretization::memory_limit_bytes`]); `None`: no
+    /// limit. The default solves stay below 1 GB (at most
+    /// [`MAX_DENSE_PANELS`] unknowns); a full-resolution one of 32 000
+    /// panels may need many GB at high frequency.
+    pub memory_limit_bytes: Option<u64>,
 }
 
 impl Default for RadiationOptions {
@@ -55,6 +61,7 @@ impl Default for RadiationOptions {
             formulation: Formulation::BurtonMiller,
             adaptive_resolution: true,
             cluster_kh: DEFAULT_CLUSTER_KH,
+            memory_limit_bytes: None,
         }
     }
 }
@@ -591,8 +598,13 @@ pub fn radiate_modes_on(
         let fresh = plan.level.near.get().is_none();
         let near = plan.level.near.get_or_init(|| NearField::new(mesh));
         let near_s = if fresh { t0.elapsed().as_secs_f64() } else { 0.0 };
-        let disc =
-            Discretization { mesh, near, clusters: &plan.clusters, aggregate: opts.adaptive_resolution };
+        let disc = Discretization {
+            mesh,
+            near,
+            clusters: &plan.clusters,
+            aggregate: opts.adaptive_resolution,
+            memory_limit_bytes: opts.memory_limit_bytes,
+        };
         let (surfaces, solver) = solve_on(&disc, opts.air, f, &fields, opts.formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
