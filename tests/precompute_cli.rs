@@ -75,6 +75,38 @@ fn json_contract_cache_and_info_agree() {
     assert_eq!(precompute(dir.path(), "c.bank", &changed)["cached"], false);
 }
 
+/// Every command writes into directories that do not exist yet, creating
+/// them before its work: a precompute used to solve, then fail on "No such
+/// file or directory" at the write. A directory that cannot be made (a file
+/// in the way) is refused before the work, and a refused input leaves no
+/// directory behind.
+#[test]
+fn outputs_go_into_new_directories_made_before_the_work() {
+    let dir = temp_dir();
+    let bar = example("bar_p1.msh");
+    let bar = bar.to_str().unwrap();
+    modal(dir.path(), &["mesh", "box", "--size", "0.2,0.02,0.01", "--h", "0.01", "-o", "m/a/box.msh"]).ok();
+    let mut solve = vec!["precompute", bar, "-o", "banks/steel/bar.bank", "--modes", "4"];
+    solve.extend(STEEL);
+    modal(dir.path(), &solve).ok();
+    let bank = "banks/steel/bar.bank";
+    modal(dir.path(), &["retune", bank, "--scale", "2", "-o", "banks/big/bar.bank"]).ok();
+    modal(dir.path(), &["export", bank, "--vtk", "vtk/bar.vtu", "--gltf", "gltf/bar.glb"]).ok();
+    modal(dir.path(), &["strike", bank, "-o", "audio/hits/bar.wav"]).ok();
+    for file in
+        ["m/a/box.msh", bank, "banks/big/bar.bank", "vtk/bar.vtu", "gltf/bar.glb", "audio/hits/bar.wav"]
+    {
+        assert!(dir.path().join(file).is_file(), "{file} not written");
+    }
+    let mut blocked = vec!["precompute", bar, "-o", "m/a/box.msh/bar.bank", "--modes", "4"];
+    blocked.extend(STEEL);
+    let run = modal(dir.path(), &blocked).fails_with("cannot create directory m/a/box.msh");
+    assert!(!run.stderr.contains("assembling"), "refused only after the work:\n{}", run.stderr);
+    let missing = ["precompute", "none.obj", "-o", "nothing/x.bank", "--material", "steel"];
+    modal(dir.path(), &missing).fails_with("none.obj");
+    assert!(!dir.path().join("nothing").exists(), "a refused input made its output directory");
+}
+
 #[test]
 fn retune_matches_a_fresh_solve() {
     let dir = temp_dir();

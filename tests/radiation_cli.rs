@@ -428,8 +428,8 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert!(stiffer.stderr.contains("does not carry over"), "{}", stiffer.stderr);
     assert!(ModeBank::load_with_radiation(dir.path().join("stiff.bank")).unwrap().1.is_none());
     // A store that cannot be written fails before the solve (the pre-flight's words).
-    modal(dir.path(), &["radiation", "sphere.bank", "--store", "missing/x.bank"])
-        .fails_with("does not exist");
+    modal(dir.path(), &["radiation", "sphere.bank", "--store", "sphere.bank/x.bank"])
+        .fails_with("cannot create directory sphere.bank");
     modal(dir.path(), &["radiation", "sphere.bank", "--store", "."]).fails_with("is a directory");
 }
 

@@ -152,7 +152,7 @@ fn side_files_that_cannot_be_written_are_refused_before_the_render() {
     render(&["--events", "out/s.wav"]).fails_with("name the same file");
     render(&["--spectrogram", "out/../out/e.json", "--events", "out/e.json"])
         .fails_with("name the same file");
-    render(&["--events", "missing/e.json"]).fails_with("does not exist");
+    render(&["--events", "s.toml/e.json"]).fails_with("cannot create directory s.toml");
     render(&["--spectrogram", "out"]).fails_with("is a directory");
     render(&["--events", "s.toml"]).fails_with("input file itself");
     // Refused whether or not a bank is to be solved (a cached scene took 0).

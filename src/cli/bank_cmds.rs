@@ -65,6 +65,7 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
     let spec = RetuneSpec { material, scale: args.scale };
     let new = modal_bank::retune(&bank, spec.clone())?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let transfer = match stored {
         Some(table) => {
             let carried = modal_bank::retune_radiation(&bank, &table, &spec);

@@ -122,12 +122,16 @@ fn gltf(
 }
 
 pub fn run(args: ExportArgs) -> Result<()> {
-    for (flag, path) in [("--vtk", &args.vtk), ("--gltf", &args.gltf), ("--faust", &args.faust)] {
-        if let Some(path) = path {
-            super::check_not_input(path, &args.bank, flag)?;
-        }
+    let outputs = [("--vtk", &args.vtk), ("--gltf", &args.gltf), ("--faust", &args.faust)];
+    let outputs: Vec<(&str, &std::path::PathBuf)> =
+        outputs.into_iter().filter_map(|(flag, path)| Some((flag, path.as_ref()?))).collect();
+    for (flag, path) in &outputs {
+        super::check_not_input(path, &args.bank, flag)?;
     }
     let (bank, radiation) = load_bank_with_radiation(&args.bank)?;
+    for (flag, path) in &outputs {
+        super::prepare_output(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
+    }
     let mut report = serde_json::Map::new();
     report.insert("bank".into(), json!(args.bank.display().to_string()));
     if let Some(path) = &args.vtk {

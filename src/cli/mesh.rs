@@ -24,6 +24,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
             super::check_not_input(&out, &input, "-o")?;
             let (surface, mut report) = modal_tetra::read_surface(&input, scale, part.as_deref())
                 .with_context(|| format!("cannot read surface mesh {}", input.display()))?;
+            super::prepare_output(&out).with_context(|| format!("cannot write {}", out.display()))?;
             if sheet_thickness.is_some() {
                 report.drop_open_warning();
             }
@@ -105,6 +106,7 @@ pub fn run(shape: MeshShape) -> Result<()> {
 fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
     let sizes = args.h.map_or_else(|| shape.default_sizes(args.order), ElementSizes::uniform);
     let h = sizes.h;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     let mesh = modal_mesh::generate::generate_sized(&shape, sizes, args.order)?;
     write_mesh(&args.out, &mesh)?;
     let summary = serde_json::json!({

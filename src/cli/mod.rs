@@ -65,16 +65,20 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// Checks, before any long work, that `path` can be written the way
+/// Makes sure, before any long work, that `path` can be written the way
 /// [`write_atomic`] (or a library's atomic writer) will write it: `path` is
-/// not a directory, and its directory exists and takes a new file (a probe
-/// file is created there and removed). So a solve of minutes never ends in
-/// "cannot write".
-pub fn check_writable(path: &Path) -> anyhow::Result<()> {
+/// not a directory, its directory exists (missing directories are created,
+/// as `precompute-batch` and `export-matrices` create theirs) and takes a new
+/// file (a probe file is created there and removed). So a solve of minutes
+/// never ends in "cannot write".
+pub fn prepare_output(path: &Path) -> anyhow::Result<()> {
     let dir = directory_of(path);
     anyhow::ensure!(!path.is_dir(), "{} is a directory", path.display());
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
-    anyhow::ensure!(dir.is_dir(), "directory {} does not exist", dir.display());
+    if !dir.is_dir() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create directory {}: {e}", dir.display()))?;
+    }
     let probe = dir.join(format!(".{}.{}.probe", name.to_string_lossy(), std::process::id()));
     std::fs::OpenOptions::new()
         .write(true)

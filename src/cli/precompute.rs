@@ -117,6 +117,11 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
         );
     }
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
+    // An input that cannot be opened is said (as the solve would say it) before
+    // the output's directory is made.
+    std::fs::File::open(&args.mesh)
+        .map_err(|e| anyhow::anyhow!("precompute {0}: cannot read {0}: {e}", args.mesh.display()))?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let spinner = Spinner::new("starting");
     // Warnings about the input are said when the mesh is read, once each, not after the solve.
     let mut said = std::collections::HashSet::new();
@@ -226,6 +231,7 @@ fn import_gltf(args: &PrecomputeArgs) -> Result<()> {
         warn("the glTF already holds modes: material flags are ignored (use `modal retune` to change them)");
     }
     let (bank, radiation) = super::bank_cmds::load_bank_with_radiation(&args.mesh)?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
     interrupt::guarded(|| match &radiation {
         Some(table) => bank.save_with_radiation(&args.out, table),
         None => bank.save(&args.out),

@@ -126,7 +126,7 @@ pub fn run(args: RadiationArgs) -> Result<()> {
         ensure!(m < bank.mode_count(), "mode {m} does not exist (the bank has {} modes)", bank.mode_count());
     }
     if let Some(path) = &args.store {
-        super::check_writable(path).with_context(|| format!("--store {}", path.display()))?;
+        super::prepare_output(path).with_context(|| format!("--store {}", path.display()))?;
     }
     let mut candidates: Vec<usize> =
         if args.mode.is_empty() { (0..bank.mode_count()).collect() } else { args.mode.clone() };

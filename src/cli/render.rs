@@ -460,9 +460,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
     // Checked here, not only when a bank is solved: a cached scene accepted 0.
     modal_precompute::check_threads(args.threads)?;
     let out = args.out.clone().unwrap_or(default_out);
-    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
-    }
     check_outputs(&out, &args)?;
     let spinner = Spinner::new("preparing the scene");
     let mut provider = PipelineProvider {
@@ -651,7 +648,7 @@ fn check_outputs(out: &Path, args: &RenderArgs) -> Result<()> {
     ];
     let named: Vec<(&str, &Path)> = named.into_iter().filter_map(|(flag, p)| Some((flag, p?))).collect();
     for (k, (flag, path)) in named.iter().enumerate() {
-        super::check_writable(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
+        super::prepare_output(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
         if let Some(scene) = &args.scene {
             super::check_not_input(path, scene, flag)?;
         }

@@ -127,7 +127,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             modal_synth::MAX_DURATION_S
         );
     }
-    super::check_writable(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     super::check_not_input(&args.out, &args.bank, "-o")?;
     let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
