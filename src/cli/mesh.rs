@@ -106,8 +106,8 @@ pub fn run(shape: MeshShape) -> Result<()> {
 fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
     let sizes = args.h.map_or_else(|| shape.default_sizes(args.order), ElementSizes::uniform);
     let h = sizes.h;
-    super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     let mesh = modal_mesh::generate::generate_sized(&shape, sizes, args.order)?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     write_mesh(&args.out, &mesh)?;
     let summary = serde_json::json!({
         "out": args.out.display().to_string(),
