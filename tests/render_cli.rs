@@ -286,3 +286,44 @@ fn a_silent_scene_and_ears_metres_apart_are_warned_about() {
     let mono = warnings("duration = 0.1\n[listener]\nchannels = \"mono\"\near_spacing = 50\n");
     assert!(!mono.contains("ear_spacing"), "one point has no spacing: {mono}");
 }
+
+/// docs/scene-format.md: `material` and `scale` on a `bank` object retune
+/// it. Both were ignored: a steel bank "in aluminium" or "twice as large"
+/// rendered the steel bank as it was. Now the render equals the one of the
+/// bank `modal retune` makes (the same retune), and differs from the bank
+/// as stored; a preset of another ν keeps the bank's, and says so.
+#[test]
+fn material_and_scale_on_a_bank_object_retune_it() {
+    let dir = temp_dir();
+    let d = dir.path();
+    modal(d, &["mesh", "box", "--size", "0.1,0.02,0.01", "--h", "0.01", "-o", "bar.msh"]).ok();
+    modal(d, &["precompute", "bar.msh", "--material", "steel", "--modes", "6", "-o", "bar.bank"]).ok();
+    let retuned = modal(d, &["retune", "bar.bank", "--material", "aluminium", "-o", "al.bank"]).ok();
+    assert!(
+        retuned.stderr.contains("aluminium's Poisson's ratio 0.33 is not the bank's 0.29"),
+        "{}",
+        retuned.stderr
+    );
+    modal(d, &["retune", "bar.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    let wav = |name: &str, object: &str| {
+        let scene = format!(
+            "duration = 0.3\nsample_rate = 16000\n[listener]\nposition = [0.0, 0.2, 0.5]\nchannels = \"mono\"\n\
+             [ground]\nmaterial = \"wood\"\n[[objects]]\nname = \"bar\"\n{object}\nposition = [0.0, 0.05, 0.0]\n"
+        );
+        std::fs::write(d.join(format!("{name}.toml")), scene).unwrap();
+        let run = modal(
+            d,
+            &["render", &format!("{name}.toml"), "-o", &format!("{name}.wav"), "--radiation", "estimate"],
+        );
+        (std::fs::read(d.join(format!("{name}.wav"))).unwrap(), run.ok().stderr)
+    };
+    let (steel, _) = wav("steel", "bank = \"bar.bank\"");
+    let (in_aluminium, said) = wav("in_al", "bank = \"bar.bank\"\nmaterial = \"aluminium\"");
+    let (aluminium, _) = wav("al", "bank = \"al.bank\"");
+    assert!(in_aluminium == aluminium, "the scene's retune is not the CLI's");
+    assert!(in_aluminium != steel, "the material was ignored");
+    assert!(said.contains("kept 0.29"), "{said}");
+    let (twice, _) = wav("twice", "bank = \"bar.bank\"\nscale = 2.0");
+    let (big, _) = wav("big", "bank = \"big.bank\"");
+    assert!(twice == big && twice != steel, "the scale was ignored");
+}

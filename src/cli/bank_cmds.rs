@@ -6,7 +6,7 @@ use modal_bank::{ModeBank, RadiationTable, RetuneSpec};
 use super::args::{InfoArgs, RetuneArgs};
 use super::bank_report::BankJson;
 use super::interrupt;
-use super::output::print_json;
+use super::output::{print_json, warn};
 
 /// Loads a bank and its stored acoustic transfer from one read of the file
 /// (so the two always come from the same version of it), naming the file in
@@ -70,7 +70,7 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         Some(table) => {
             let carried = modal_bank::retune_radiation(&bank, &table, &spec);
             if carried.is_none() {
-                super::output::warn(&format!(
+                warn(&format!(
                     "the stored acoustic transfer does not carry over: E/ρ changed, so every mode sits at a new \
                      ka. Solve it again: modal radiation {0} --store {0}",
                     args.out.display()
@@ -105,5 +105,27 @@ fn retuned_material(bank: &ModeBank, args: &RetuneArgs) -> Result<modal_fem::Mat
     material.alpha = m.alpha.unwrap_or(material.alpha);
     material.beta = m.beta.unwrap_or(material.beta);
     material.validate()?;
+    if m.poisson.is_some() {
+        // Asked for by name: a ν the bank does not have is the library's error.
+        return Ok(material);
+    }
+    // A preset's ν (README: "new E, rho (same nu)"): the bank's is kept, and said.
+    let (material, asked) = modal_bank::keeping_poisson(bank, material);
+    if let Some(asked) = asked {
+        warn(&poisson_kept_warning(bank, &material, asked));
+    }
     Ok(material)
+}
+
+/// The warning when a retune to `material` kept `bank`'s Poisson's ratio
+/// instead of the `asked` one: what a new solve would change, at most.
+pub fn poisson_kept_warning(bank: &ModeBank, material: &modal_fem::Material, asked: f64) -> String {
+    let kept = bank.material.poisson;
+    let name = material.name.as_deref().map_or("the material", |n| n.trim_end_matches("+custom"));
+    format!(
+        "{name}'s Poisson's ratio {asked} is not the bank's {kept}: kept {kept} (a retune scales E and ρ; \
+         a new ν changes the mode shapes and needs a new solve, which would move the frequencies by up to \
+         {:.1} %)",
+        100.0 * modal_bank::poisson_shift(kept, asked)
+    )
 }

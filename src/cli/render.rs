@@ -52,6 +52,9 @@ struct PipelineProvider<'a> {
     /// The solver's memory guard [bytes] when `MODAL_MEMORY_LIMIT_GB` sets it
     /// (else the eigensolver's default).
     memory_limit_bytes: Option<u64>,
+    /// Bank files retuned to their object's material or scale, each with its
+    /// stored transfer as it carries over (`None`: it does not, or none).
+    retuned: Vec<(BankRequest, Option<RadiationTable>)>,
 }
 
 /// Refuses a generated shape whose quadratic mesh could not fit the memory
@@ -89,6 +92,9 @@ fn refuse_beyond_memory(
 impl BankProvider for PipelineProvider<'_> {
     fn bank(&mut self, request: &BankRequest) -> Result<Arc<ModeBank>, ProviderError> {
         if let Some(path) = &request.bank {
+            if request.material.is_some() || request.scale.is_some() {
+                return self.retuned_bank_file(request, path).map(Arc::new);
+            }
             if modal_export::gltf::is_gltf_path(path) {
                 let imported = modal_export::gltf::import_gltf_file(path)?;
                 self.warnings.extend(imported.warnings.iter().map(|w| format!("{}: {w}", path.display())));
@@ -172,6 +178,15 @@ impl BankProvider for PipelineProvider<'_> {
             (None, None) => return Ok(None),
         };
         if let Some(path) = &request.bank {
+            if let Some((_, table)) = self.retuned.iter().find(|(r, _)| r == request) {
+                if table.is_none() {
+                    self.warnings.push(format!(
+                        "{what}, retuned to the object's material: no stored transfer carries over (E/ρ moved \
+                         every mode to a new ka): its level is a pulsating-sphere estimate"
+                    ));
+                }
+                return Ok(table.clone().map(Arc::new));
+            }
             let table = super::listener::stored_radiation(path)?;
             if table.is_none() {
                 self.warnings.push(format!(
@@ -208,6 +223,34 @@ fn recipe(
 }
 
 impl PipelineProvider<'_> {
+    /// A bank file retuned to its object's `material` and `scale`
+    /// (docs/scene-format.md): E and ρ scale the frequencies, the bank's ν is
+    /// kept (said when the material's differs), and the stored transfer
+    /// carries over only when the retune keeps every mode's ka.
+    fn retuned_bank_file(&mut self, request: &BankRequest, path: &Path) -> Result<ModeBank, ProviderError> {
+        let (bank, table) = if modal_export::gltf::is_gltf_path(path) {
+            let imported = modal_export::gltf::import_gltf_file(path)?;
+            self.warnings.extend(imported.warnings.iter().map(|w| format!("{}: {w}", path.display())));
+            (imported.bank, imported.radiation)
+        } else {
+            ModeBank::load_with_radiation(path)?
+        };
+        let material = request.material.clone().map(|material| {
+            let (material, asked) = modal_bank::keeping_poisson(&bank, material);
+            if let Some(asked) = asked {
+                let said = super::bank_cmds::poisson_kept_warning(&bank, &material, asked);
+                self.warnings.push(format!("{}: {said}", path.display()));
+            }
+            material
+        });
+        let spec = modal_bank::RetuneSpec { material, scale: request.scale };
+        let retuned =
+            modal_bank::retune(&bank, spec.clone()).map_err(|e| format!("{}: {e}", path.display()))?;
+        let table = table.and_then(|t| modal_bank::retune_radiation(&bank, &t, &spec));
+        self.retuned.push((request.clone(), table));
+        Ok(retuned)
+    }
+
     /// The transfer of a mesh asset's bank: from the cache entry keyed by
     /// the bank's key and the radiation settings, or solved now and cached.
     fn solved_radiation(
@@ -474,6 +517,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         radiation_solved: Vec::new(),
         transfer_max_hz: args.transfer_max_freq.unwrap_or(DEFAULT_TRANSFER_MAX_HZ),
         memory_limit_bytes: memory_limit_from_env()?,
+        retuned: Vec::new(),
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);

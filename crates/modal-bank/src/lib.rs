@@ -35,7 +35,7 @@ mod vtu;
 
 pub use cache::{default_dir_from, BankCache, CACHE_DIR_ENV};
 pub use key::CacheKey;
-pub use retune::{retune, retune_radiation, RetuneSpec, RETUNED_PREFIX};
+pub use retune::{keeping_poisson, poisson_shift, retune, retune_radiation, RetuneSpec, RETUNED_PREFIX};
 pub use vtu::{export_vtu, export_vtu_file, mode_array_name};
 
 pub use damping::rayleigh;

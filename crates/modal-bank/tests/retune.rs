@@ -3,7 +3,7 @@
 mod common;
 
 use common::{linear_bank, quadratic_bank, steel};
-use modal_bank::{retune, BankError, ModeBank, RetuneSpec};
+use modal_bank::{keeping_poisson, poisson_shift, retune, BankError, ModeBank, RetuneSpec};
 use modal_fem::Material;
 use std::f64::consts::PI;
 
@@ -131,6 +131,43 @@ fn poisson_change_needs_a_new_solve() {
     let err = retune(&linear_bank(2), with_material(m)).unwrap_err();
     assert!(matches!(err, BankError::PoissonChanged { .. }));
     assert!(err.to_string().starts_with("changing Poisson's ratio needs a new solve"), "{err}");
+}
+
+/// "This steel bank in aluminium": E and ρ move, ν stays the bank's (a
+/// retune cannot change it), the preset is named `+custom` and the ν it
+/// asked for is returned, for the caller's warning.
+#[test]
+fn a_preset_of_another_poisson_ratio_keeps_the_banks() {
+    let bank = linear_bank(2);
+    let aluminium = Material::preset("aluminium").unwrap();
+    let (kept, asked) = keeping_poisson(&bank, aluminium.clone());
+    assert_eq!(asked, Some(0.33));
+    assert_eq!((kept.poisson, kept.youngs_pa, kept.density_kg_m3), (0.29, 7.0e10, 2700.0));
+    assert_eq!(kept.name.as_deref(), Some("aluminium+custom"));
+    let retuned = retune(&bank, with_material(kept)).unwrap();
+    let ratio = retuned.frequencies_hz[0] / bank.frequencies_hz[0];
+    assert!(rel(ratio, (3.5e-1_f64 / (2700.0 / 7850.0)).sqrt()) < 1e-12, "{ratio}");
+    // The same ν: nothing changes, nothing is said.
+    let (same, none) = keeping_poisson(&bank, steel());
+    assert_eq!((same, none), (steel(), None));
+}
+
+/// The bound on what ν moves a frequency, against the wave speeds from the
+/// Lamé constants `λ = Eν/((1+ν)(1−2ν))`, `μ = E/(2(1+ν))`:
+/// `c_s² = μ/ρ`, `c_p² = (λ+2μ)/ρ`, and a plate's `D ∝ E/(1−ν²)`.
+#[test]
+fn the_poisson_shift_is_the_largest_wave_speed_change() {
+    let speeds = |nu: f64| {
+        let (e, rho) = (7.0e10, 2700.0);
+        let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = e / (2.0 * (1.0 + nu));
+        [(mu / rho).sqrt(), ((lambda + 2.0 * mu) / rho).sqrt(), (e / (1.0 - nu * nu)).sqrt()]
+    };
+    let (a, b) = (speeds(0.29), speeds(0.33));
+    let want = (0..3).map(|i| (b[i] / a[i] - 1.0).abs()).fold(0.0, f64::max);
+    assert!(rel(poisson_shift(0.29, 0.33), want) < 1e-12, "{} vs {want}", poisson_shift(0.29, 0.33));
+    assert!((poisson_shift(0.29, 0.33) - 0.0633).abs() < 5e-4, "compression moves most");
+    assert_eq!(poisson_shift(0.3, 0.3), 0.0);
 }
 
 #[test]
