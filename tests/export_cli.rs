@@ -162,6 +162,13 @@ fn faust_export_refuses_bad_input_and_leaves_nothing() {
     assert_eq!(run.code, Some(2));
     // No output format at all.
     assert_eq!(modal(dir.path(), &["export", "bar.bank"]).code, Some(2));
+    // With --json a malformed command line is one JSON object on stdout too.
+    let typo = modal(dir.path(), &["info", "bar.bank", "--json", "--jsno"]);
+    assert_eq!(typo.code, Some(2));
+    assert_eq!(typo.json()["error"].as_str(), Some("unexpected argument '--jsno' found"), "{}", typo.stdout);
+    assert!(typo.stderr.contains("a similar argument exists: '--json'"), "{}", typo.stderr);
+    let help = modal(dir.path(), &["info", "--help", "--json"]);
+    assert!(help.success && help.stdout.contains("Usage: modal info"), "help stays help: {}", help.stdout);
 }
 
 #[test]

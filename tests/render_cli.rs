@@ -153,6 +153,10 @@ fn side_files_that_cannot_be_written_are_refused_before_the_render() {
     render(&["--spectrogram", "out/../out/e.json", "--events", "out/e.json"])
         .fails_with("name the same file");
     render(&["--events", "s.toml/e.json"]).fails_with("cannot create directory s.toml");
+    // The WAV's new directory was made before the --events check failed: removed again.
+    let made = ["render", "s.toml", "-o", "new/dir/s.wav", "--events", "s.toml/e.json", "--radiation", "estimate"];
+    modal(dir.path(), &made).fails_with("cannot create directory s.toml");
+    assert!(!dir.path().join("new").exists(), "a failed render left the directory it made");
     render(&["--spectrogram", "out"]).fails_with("is a directory");
     render(&["--events", "s.toml"]).fails_with("input file itself");
     // Refused whether or not a bank is to be solved (a cached scene took 0).

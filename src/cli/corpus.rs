@@ -7,7 +7,6 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use super::output::print_json;
-use super::write_atomic;
 
 /// Arguments of `modal mesh corpus`.
 #[derive(Debug, Args)]
@@ -41,13 +40,7 @@ pub fn run(args: CorpusArgs) -> Result<()> {
     for info in selected {
         let surface = asset(info.name).with_context(|| format!("corpus asset {} is missing", info.name))?;
         let path = args.out.join(format!("{}.obj", info.name));
-        write_atomic(&path, |tmp| {
-            let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-            modal_tetra::write_obj(&surface, &mut file)?;
-            std::io::Write::flush(&mut file)?;
-            Ok(())
-        })
-        .with_context(|| format!("cannot write {}", path.display()))?;
+        super::write_buffered(&path, |file| modal_tetra::write_obj(&surface, file))?;
         if !args.json {
             println!(
                 "wrote {} ({} triangles): {}",

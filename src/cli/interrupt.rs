@@ -16,6 +16,7 @@ static WRITES_IN_PROGRESS: AtomicUsize = AtomicUsize::new(0);
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 fn exit_interrupted() -> ! {
+    super::files::remove_made_directories();
     eprintln!("error: interrupted");
     std::process::exit(130)
 }
@@ -39,6 +40,12 @@ pub fn install() {
             exit_interrupted();
         }
     });
+}
+
+/// True once an interrupt came: a write under way keeps its output only
+/// if it was renamed into place before.
+pub fn stopping() -> bool {
+    INTERRUPTED.load(SeqCst)
 }
 
 /// Runs `write` (which creates an output file atomically) so that an

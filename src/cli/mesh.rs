@@ -6,7 +6,6 @@ use modal_mesh::TetMesh;
 
 use super::args::{GenerateArgs, MeshShape};
 use super::output::{print_json, warn};
-use super::write_atomic;
 
 pub fn run(shape: MeshShape) -> Result<()> {
     match shape {
@@ -133,11 +132,5 @@ fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
 }
 
 fn write_mesh(path: &std::path::Path, mesh: &TetMesh) -> Result<()> {
-    write_atomic(path, |tmp| {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-        modal_mesh::write_msh41(mesh, &mut file)?;
-        std::io::Write::flush(&mut file)?;
-        Ok(())
-    })
-    .with_context(|| format!("cannot write {}", path.display()))
+    super::write_buffered(path, |file| modal_mesh::write_msh41(mesh, file))
 }

@@ -10,6 +10,7 @@ mod bench;
 mod catalogue;
 mod corpus;
 mod export;
+mod files;
 mod interrupt;
 mod listener;
 mod material;
@@ -21,27 +22,47 @@ mod radiation;
 mod render;
 mod strike;
 
-use std::path::Path;
 use std::process::ExitCode;
 
 use clap::Parser;
 
 pub use args::{Cli, Command};
+pub use files::{
+    buffered, check_not_input, directory_of, prepare_output, write_atomic, write_atomic_all, write_buffered,
+};
 
 /// Parses the command line, runs the command and maps the outcome to an exit code.
 pub fn run() -> ExitCode {
-    let cli = Cli::parse();
     // `--json` is a flag of every command that has it, never an option's value.
     let json = std::env::args_os().any(|a| a == "--json");
+    let cli = Cli::try_parse().unwrap_or_else(|err| malformed(err, json));
     interrupt::install();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
+            files::remove_made_directories();
             output::print_error(&err, json);
             ExitCode::from(1)
         }
     }
+}
+
+/// A command line clap refuses (exit code 2), or `--help`/`--version`.
+/// With `--json`, stdout also holds `{"error": "…"}` (the first line of
+/// clap's message), as for every other error: a script reads one object.
+fn malformed(err: clap::Error, json: bool) -> ! {
+    use clap::error::ErrorKind;
+    let shown = matches!(
+        err.kind(),
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    );
+    if json && !shown {
+        let text = err.render().to_string();
+        let line = text.lines().next().unwrap_or_default().trim_start_matches("error: ").to_string();
+        println!("{}", serde_json::json!({ "error": line }));
+    }
+    err.exit()
 }
 
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
@@ -63,78 +84,4 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Bench(command)) => bench::run(command),
         Some(Command::Radiation(args)) => radiation::run(args),
     }
-}
-
-/// Makes sure, before any long work, that `path` can be written the way
-/// [`write_atomic`] (or a library's atomic writer) will write it: `path` is
-/// not a directory, its directory exists (missing directories are created,
-/// as `precompute-batch` and `export-matrices` create theirs) and takes a new
-/// file (a probe file is created there and removed). So a solve of minutes
-/// never ends in "cannot write".
-pub fn prepare_output(path: &Path) -> anyhow::Result<()> {
-    let dir = directory_of(path);
-    anyhow::ensure!(!path.is_dir(), "{} is a directory", path.display());
-    let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
-    if !dir.is_dir() {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("cannot create directory {}: {e}", dir.display()))?;
-    }
-    let probe = dir.join(format!(".{}.{}.probe", name.to_string_lossy(), std::process::id()));
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&probe)
-        .map_err(|e| anyhow::anyhow!("cannot write in {}: {e}", dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
-}
-
-/// The directory a file `path` is in (`.` for a bare name).
-pub fn directory_of(path: &Path) -> &Path {
-    path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."))
-}
-
-/// Refuses an output `out` (given as `flag`) that is the input file
-/// `input` itself (the same file, through any path, link or hard link): the
-/// write would replace what the command reads, a bank by a WAV, a mesh by a
-/// bank. Commands that update a file in place on purpose (`retune`,
-/// `radiation --store`) do not call this.
-pub fn check_not_input(out: &Path, input: &Path, flag: &str) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        !same_file(out, input),
-        "{flag} {} is the input file itself: writing there would destroy it; give the output its own name",
-        out.display()
-    );
-    Ok(())
-}
-
-/// Whether `a` and `b` name one existing file.
-fn same_file(a: &Path, b: &Path) -> bool {
-    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else { return false };
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        ma.dev() == mb.dev() && ma.ino() == mb.ino()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (ma, mb);
-        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
-    }
-}
-
-/// Writes a file atomically: `write` fills a temporary file next to `path`,
-/// which is then renamed over `path`. On any error the temporary file is
-/// removed, so a failed or interrupted command never leaves a partial output.
-pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
-    let dir = directory_of(path);
-    let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    interrupt::guarded(|| {
-        let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Into::into));
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result
-    })
 }

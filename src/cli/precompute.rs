@@ -11,7 +11,7 @@ use super::bank_report::BankJson;
 use super::interrupt;
 use super::output::{print_json, warn};
 use super::progress::Spinner;
-use super::{material, write_atomic};
+use super::{buffered, material, write_atomic_all};
 
 /// Builds a pipeline request from the shared mesh and material flags.
 fn request(mesh: &Path, material_args: &MaterialArgs, input: &MeshInputArgs) -> Result<Request> {
@@ -171,30 +171,28 @@ fn transfer(bank: &modal_bank::ModeBank, max_hz: f64) -> Result<Option<modal_ban
 
 pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
     let request = request(&args.mesh, &args.material, &args.input)?;
+    std::fs::File::open(&args.mesh)
+        .map_err(|e| anyhow::anyhow!("export-matrices {0}: cannot read {0}: {e}", args.mesh.display()))?;
+    // Made and probed before the assembly, which can take minutes.
+    let [k_path, m_path, nodes_path] = ["K.mtx", "M.mtx", "nodes.csv"].map(|name| args.out.join(name));
+    for path in [&k_path, &m_path, &nodes_path] {
+        super::prepare_output(path).with_context(|| format!("cannot write {}", path.display()))?;
+    }
     let spinner = Spinner::new("starting");
     let assembled = modal_precompute::assemble_matrices(&request, &mut |s| spinner.set(describe(&s)));
     spinner.finish();
     let assembled = assembled.with_context(|| format!("export-matrices {}", args.mesh.display()))?;
     assembled.warnings.iter().for_each(|w| warn(w));
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create directory {}", args.out.display()))?;
-    let write =
-        |name: &str, f: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>| -> Result<()> {
-            let path = args.out.join(name);
-            write_atomic(&path, |tmp| {
-                let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-                f(&mut file)?;
-                std::io::Write::flush(&mut file)?;
-                Ok(())
-            })
-            .with_context(|| format!("cannot write {}", path.display()))
-        };
     // The entries the files hold (the lower triangle without exact zeros), beside
     // `nnz_k`, the assembled matrix's stored entries (both triangles).
     let (mut entries_k, mut entries_m) = (0, 0);
-    write("K.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.k, w).map(|n| entries_k = n))?;
-    write("M.mtx", &mut |w| modal_fem::write_matrix_market(&assembled.m, w).map(|n| entries_m = n))?;
-    write("nodes.csv", &mut |w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))?;
+    // One output: all three files, or none (an interrupt between them left K.mtx alone).
+    write_atomic_all(vec![
+        (&k_path, buffered(|w| modal_fem::write_matrix_market(&assembled.k, w).map(|n| entries_k = n))),
+        (&m_path, buffered(|w| modal_fem::write_matrix_market(&assembled.m, w).map(|n| entries_m = n))),
+        (&nodes_path, buffered(|w| modal_fem::write_nodes_csv(&assembled.mesh.nodes, w))),
+    ])
+    .with_context(|| format!("cannot write the matrices into {}", args.out.display()))?;
     let summary = serde_json::json!({
         "dir": args.out.display().to_string(),
         "nodes": assembled.mesh.nodes.len(),

@@ -9,8 +9,9 @@
 //! A process ended while a write is under way (`exit` runs no destructor)
 //! would leave the temporary file. So the writes in progress are counted,
 //! and a program that stops on a signal first calls [`request_stop`]: no
-//! write starts after it, and the program ends once
-//! [`writes_in_progress`] is zero (the CLI's SIGINT/SIGTERM handler).
+//! write starts after it, none under way is renamed into place, and the
+//! program ends once [`writes_in_progress`] is zero (the CLI's SIGINT/SIGTERM
+//! handler).
 
 use crate::{BankError, ModeBank};
 use std::io::{BufWriter, Write};
@@ -21,7 +22,8 @@ static WRITES_IN_PROGRESS: AtomicUsize = AtomicUsize::new(0);
 static STOP_REQUESTED: AtomicBool = AtomicBool::new(false);
 
 /// Refuses every atomic write that has not started yet (it fails with
-/// [`std::io::ErrorKind::Interrupted`]); the ones under way finish.
+/// [`std::io::ErrorKind::Interrupted`]); the ones under way finish their
+/// temporary file, which is then removed instead of renamed into place.
 pub fn request_stop() {
     STOP_REQUESTED.store(true, SeqCst);
 }
@@ -79,6 +81,12 @@ pub fn write_file_atomically(
     let mut tmp = builder.tempfile_in(&dir)?;
     write(tmp.as_file_mut())?;
     tmp.as_file().sync_all()?;
+    if STOP_REQUESTED.load(SeqCst) {
+        // Stopped while it was written: the file is complete but the command
+        // is not (a strike of an hour cut at 2 s was left whole, then said
+        // "interrupted"). Nothing is left behind; the temporary file goes.
+        return Err(std::io::Error::new(std::io::ErrorKind::Interrupted, "the program is stopping"));
+    }
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
