@@ -154,7 +154,8 @@ fn side_files_that_cannot_be_written_are_refused_before_the_render() {
         .fails_with("name the same file");
     render(&["--events", "s.toml/e.json"]).fails_with("cannot create directory s.toml");
     // The WAV's new directory was made before the --events check failed: removed again.
-    let made = ["render", "s.toml", "-o", "new/dir/s.wav", "--events", "s.toml/e.json", "--radiation", "estimate"];
+    let made =
+        ["render", "s.toml", "-o", "new/dir/s.wav", "--events", "s.toml/e.json", "--radiation", "estimate"];
     modal(dir.path(), &made).fails_with("cannot create directory s.toml");
     assert!(!dir.path().join("new").exists(), "a failed render left the directory it made");
     render(&["--spectrogram", "out"]).fails_with("is a directory");

@@ -136,6 +136,29 @@ fn bad_strikes_fail_cleanly_without_output() {
     assert!(files_in(dir.path()).iter().all(|f| !f.ends_with(".tmp")));
 }
 
+/// A strike late in the file: the automatic length rings on after it (a
+/// strike at 31 s wrote 30 s of silence, blamed on the strike's direction);
+/// a time beyond the longest file, or negative, is refused before anything
+/// is said or solved.
+#[test]
+fn a_late_strike_is_heard_and_an_impossible_time_is_refused_first() {
+    let dir = temp_dir();
+    bar_bank(dir.path());
+    let late = modal(dir.path(), &["strike", "bar.bank", "--time", "31", "-o", "late.wav", "--json"]).ok();
+    let report = late.json();
+    assert!(report["duration_s"].as_f64().unwrap() > 31.0, "{report}");
+    assert!(!late.stderr.contains("silent"), "{}", late.stderr);
+    let samples = wav_samples(&dir.path().join("late.wav"));
+    let start = (31.0 * report["sample_rate"].as_f64().unwrap()) as usize;
+    assert!(samples[..start].iter().all(|&s| s == 0), "sound before the strike");
+    assert!(samples[start..].iter().any(|&s| s.abs() > 100), "the strike is not heard");
+    for time in ["-1", "1e9"] {
+        let run =
+            modal(dir.path(), &["strike", "bar.bank", "--time", time, "-o", "x.wav"]).fails_with("--time");
+        assert!(!run.stderr.contains("strike: no --at"), "said before the refusal: {}", run.stderr);
+    }
+}
+
 #[test]
 fn a_strike_that_rounds_to_silence_says_so() {
     // A body heavy for its tap (a 35 kg beam, or a file read in the wrong unit)
@@ -202,7 +225,7 @@ fn tables_number_modes_as_json_and_radiation_mode_do() {
     assert!(!want.is_empty());
     assert_eq!(listed, want);
     // Pressure at the listener is printed in Pa, not the contact microphone's m/s.
-    assert!(human.contains(" Pa  T60"), "{human}");
+    assert!(human.contains(" Pa (0.0") && human.contains(" of full scale)  T60"), "{human}");
 }
 
 /// The level of a float WAV's component at `f_hz` (one DFT bin over the whole file).

@@ -89,6 +89,17 @@ pub enum TransferSource {
     Estimate,
 }
 
+impl TransferSource {
+    /// The name `--json` gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TransferSource::Stored => "stored",
+            TransferSource::Solved => "solved",
+            TransferSource::Estimate => "estimate",
+        }
+    }
+}
+
 /// Per-mode output gains (sample units per unit modal velocity) at a listener.
 pub struct ListenerGains {
     /// One gain per bank mode: `|T_i| / FULL_SCALE_PA`.

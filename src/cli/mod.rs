@@ -55,7 +55,9 @@ fn malformed(err: clap::Error, json: bool) -> ! {
     use clap::error::ErrorKind;
     let shown = matches!(
         err.kind(),
-        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
     );
     if json && !shown {
         let text = err.render().to_string();

@@ -21,7 +21,8 @@ use super::output::{print_json, warn};
 /// Default impulse [N·s]: a light tap (a 10 g striker at 1 m/s).
 pub const DEFAULT_IMPULSE_NS: f64 = 0.01;
 
-/// Longest automatic duration [s]; a fade-out ends sounds that ring longer.
+/// Longest automatic ring after the last strike [s]; a fade-out ends sounds
+/// that ring longer.
 pub const AUTO_DURATION_CAP_S: f64 = 30.0;
 /// Level of `--normalize`: peak at −1 dBFS.
 const NORMALIZED_PEAK: f64 = 0.891;
@@ -70,7 +71,11 @@ struct StrikePointJson {
 #[derive(Serialize)]
 struct TopModeJson {
     mode: usize,
+    /// Undamped, as `info` and `radiation` give it.
     frequency_hz: f64,
+    /// The frequency it rings at.
+    damped_frequency_hz: f64,
+    /// Peak amplitude as a fraction of full scale (20 Pa, or 1 m/s at `--mic`).
     amplitude: f64,
     t60_s: Option<f64>,
 }
@@ -129,15 +134,17 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     }
     super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     super::check_not_input(&args.out, &args.bank, "-o")?;
+    for &t in &args.time {
+        ensure!(
+            t.is_finite() && (0.0..modal_synth::MAX_DURATION_S).contains(&t),
+            "--time must be from 0 s to below {} s, the longest file (got {t})",
+            modal_synth::MAX_DURATION_S
+        );
+    }
     let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
     let at_points = if args.at.is_empty() {
-        let at = farthest_surface_point(&bank).context("the bank has no surface to strike")?;
-        eprintln!(
-            "strike: no --at, so struck at ({:.4}, {:.4}, {:.4}) m, the surface point farthest from the centre of mass",
-            at[0], at[1], at[2]
-        );
-        vec![at]
+        vec![farthest_surface_point(&bank).context("the bank has no surface to strike")?]
     } else {
         args.at.clone()
     };
@@ -163,6 +170,13 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             impulse_ns,
             time_s,
         });
+    }
+    if let ([at], true) = (at_points.as_slice(), args.at.is_empty()) {
+        // Said once the strike is known to be valid, before the slow part.
+        eprintln!(
+            "strike: no --at, so struck at ({:.4}, {:.4}, {:.4}) m, the surface point farthest from the centre of mass",
+            at[0], at[1], at[2]
+        );
     }
     // Output: the pressure at a listener (default), or a contact microphone.
     let (gain, phases, output) = match args.mic {
@@ -206,9 +220,12 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             warn(&format!("{late} strike(s) at or after the end of the --duration {d} s are not heard"));
         }
     }
+    // The automatic length rings on for at most the cap after the last strike
+    // (a lone strike at --time 31 wrote 30 s of silence).
+    let last_s = strikes.iter().map(|s| s.time_s).fold(0.0, f64::max);
     let length = match args.duration {
         Some(d) => RenderLength::Fixed(d),
-        None => RenderLength::Auto { cap_s: AUTO_DURATION_CAP_S },
+        None => RenderLength::Auto { cap_s: (last_s + AUTO_DURATION_CAP_S).min(modal_synth::MAX_DURATION_S) },
     };
     let rendered = render_strikes(&bank, &strikes, &options, length)?;
     let top_modes = top_modes(&bank, &strikes[0], &options)?;
@@ -225,7 +242,11 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         ));
     }
     if rendered.capped {
-        warn(&format!("the sound rings longer than {AUTO_DURATION_CAP_S} s: faded out at the cap"));
+        warn(&format!(
+            "the sound rings longer than {AUTO_DURATION_CAP_S} s after the last strike: faded out at {:.1} s \
+             (--duration sets the length)",
+            rendered.duration_s
+        ));
     }
     let stats = &rendered.stats;
     if stats.modes_total == 0 {
@@ -307,7 +328,8 @@ fn top_modes(bank: &ModeBank, strike: &Strike, options: &SynthOptions) -> Result
         .take(8)
         .map(|m| TopModeJson {
             mode: m.mode,
-            frequency_hz: m.frequency_hz,
+            frequency_hz: bank.frequencies_hz[m.mode],
+            damped_frequency_hz: m.frequency_hz,
             amplitude: m.amplitude,
             t60_s: (m.decay_rate > 0.0).then(|| 1000f64.ln() / m.decay_rate),
         })
@@ -316,23 +338,29 @@ fn top_modes(bank: &ModeBank, strike: &Strike, options: &SynthOptions) -> Result
 
 fn print_human(json: &StrikeJson) {
     for (k, s) in json.strikes.iter().enumerate() {
+        let snapped = if s.distance_m == 0.0 {
+            "on the surface".into()
+        } else {
+            format!("snapped {:.2e} m", s.distance_m)
+        };
+        // `+ 0.0` shows a negative zero as 0.
+        let [ix, iy, iz] = s.impulse_ns.map(|c| c + 0.0);
         println!(
-            "strike {}: t = {:.4} s at ({:.4}, {:.4}, {:.4}) m (snapped {:.2e} m), impulse ({:.3e}, {:.3e}, {:.3e}) N·s",
+            "strike {}: t = {:.4} s at ({:.4}, {:.4}, {:.4}) m ({snapped}), impulse ({ix:.3e}, {iy:.3e}, {iz:.3e}) N·s",
             k + 1,
             s.time_s,
             s.surface_point[0],
             s.surface_point[1],
             s.surface_point[2],
-            s.distance_m,
-            s.impulse_ns[0],
-            s.impulse_ns[1],
-            s.impulse_ns[2]
         );
     }
     match (&json.output.listener_m, json.output.transfer) {
         (Some(l), Some(t)) => println!(
-            "output: pressure at the listener ({:.4}, {:.4}, {:.4}) m, full scale 20 Pa (transfer: {t:?})",
-            l[0], l[1], l[2]
+            "output: pressure at the listener ({:.4}, {:.4}, {:.4}) m, full scale 20 Pa (transfer: {})",
+            l[0],
+            l[1],
+            l[2],
+            t.name()
         ),
         _ => println!("output: contact microphone, normal surface velocity, full scale 1 m/s"),
     }
@@ -342,10 +370,11 @@ fn print_human(json: &StrikeJson) {
     for m in &json.top_modes {
         let t60 = m.t60_s.map_or("inf".into(), |t| format!("{t:.3} s"));
         println!(
-            "  mode {:>3}  {:>10.2} Hz  amplitude {:.3e} {unit}  T60 {}",
+            "  mode {:>3}  {:>10.2} Hz  amplitude {:.3e} {unit} ({:.3} of full scale)  T60 {}",
             m.mode,
             m.frequency_hz,
             m.amplitude * scale,
+            m.amplitude,
             t60
         );
     }
