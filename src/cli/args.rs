@@ -9,7 +9,14 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 ///
 /// With no subcommand, renders the built-in demo scene to audio_out/demo.wav.
 #[derive(Debug, Parser)]
-#[command(name = "modal", version, about, long_about = None)]
+#[command(
+    name = "modal",
+    version,
+    about,
+    long_about = None,
+    after_help = "With no command, modal renders the built-in demo scene to audio_out/demo.wav (what \
+                  `cargo run --release` does)."
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
