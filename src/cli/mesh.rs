@@ -119,13 +119,14 @@ fn generate(shape: Shape, args: GenerateArgs) -> Result<()> {
     if args.json {
         print_json(&summary)
     } else {
+        // Four decimals of a metre for ordinary sizes, three digits otherwise.
+        let h = if (1e-3..1e3).contains(&h) { format!("{h:.4}") } else { format!("{h:.3e}") };
         println!(
-            "wrote {} ({} nodes, {} tets, order {}, element size {:.4} m)",
+            "wrote {} ({} nodes, {} tets, order {}, element size {h} m)",
             args.out.display(),
             mesh.nodes.len(),
             mesh.cells.len(),
             mesh.order(),
-            h
         );
         Ok(())
     }

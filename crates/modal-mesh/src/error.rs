@@ -156,8 +156,9 @@ pub enum MeshError {
     },
     /// A generated mesh would be absurdly large.
     #[error(
-        "the requested mesh would have {count} tets, more than the limit {limit}, even at the default size if none \
-         was given; give a larger element size (`--h`, or `element_size` in a scene)"
+        "the requested mesh would have {} tets, more than the limit {limit}, even at the default size if none \
+         was given; give a larger element size (`--h`, or `element_size` in a scene)",
+        if *count == u64::MAX { "more than 1.8e19".to_string() } else { format!("{:.3e}", *count as f64) }
     )]
     TooManyElements {
         /// Requested tet count.

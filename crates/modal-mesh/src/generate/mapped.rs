@@ -156,13 +156,31 @@ pub(crate) fn ogrid<const D: usize>(q: [f64; D], a: f64) -> [f64; D] {
     s.map(|x| x * factor)
 }
 
-/// Errors unless `value` is a finite positive length.
+/// Lengths a generated shape takes [m]: a 1 µm bead to a 10 km span. Beyond
+/// them a typo (`1e300`, `1e-300`) made a mesh whose sizes printed as 300
+/// digits, or as 0, and whose solve then failed on its degenerate or
+/// infinite size.
+pub const LENGTH_RANGE_M: std::ops::RangeInclusive<f64> = 1e-6..=1e4;
+
+/// Errors unless `value` is a finite positive length in [`LENGTH_RANGE_M`].
 pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), MeshError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(MeshError::InvalidParameter { name, message: format!("{value} is not a finite positive length") })
+    if !(value.is_finite() && value > 0.0) {
+        return Err(MeshError::InvalidParameter {
+            name,
+            message: format!("{value} is not a finite positive length"),
+        });
     }
+    if !LENGTH_RANGE_M.contains(&value) {
+        return Err(MeshError::InvalidParameter {
+            name,
+            message: format!(
+                "{value:e} m is outside the lengths a generated shape takes, {:e} ..= {:e} m",
+                LENGTH_RANGE_M.start(),
+                LENGTH_RANGE_M.end()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Errors unless `small < large`.

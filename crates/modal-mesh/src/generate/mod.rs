@@ -12,7 +12,7 @@ mod mapped;
 mod shapes;
 
 pub use boxes::box_mesh;
-pub use mapped::MAX_GENERATED_TETS;
+pub use mapped::{LENGTH_RANGE_M, MAX_GENERATED_TETS};
 pub use shapes::{bowl, cylinder, sphere, tube, tube_sized};
 
 use crate::{to_quadratic, MeshError, TetMesh};
@@ -299,13 +299,14 @@ fn smallest_fitting(lo: f64, hi: f64, fits: impl Fn(f64) -> bool) -> f64 {
 pub fn generate_sized(shape: &Shape, sizes: ElementSizes, order: u8) -> Result<TetMesh, MeshError> {
     check_proportions(shape)?;
     let h = sizes.h;
-    positive("h", h)?;
     mapped::check_order(order)?;
+    // The shape's own lengths are checked before h (a default h follows from them).
     match *shape {
         Shape::Box { size } => {
             for (name, s) in ["size x", "size y", "size z"].into_iter().zip(size) {
                 positive(name, s)?;
             }
+            positive("h", h)?;
             let cells = size.map(|s| shapes::cells_for(s, h));
             mapped::check_count(mapped::tet_count(cells))?;
             let linear = box_mesh(size, cells);
@@ -335,6 +336,33 @@ mod budget_tests {
         // A 1 m sheet 0.2 mm thick is a real object (checked before any meshing).
         let sheet = Shape::Box { size: [1.0, 2e-4, 1.0] };
         assert!(check_proportions(&sheet).is_ok());
+    }
+
+    /// A typo's length (`1e300`, `1e-300`) is refused by name, the shape's
+    /// own length before the element size it implies; a count that
+    /// overflowed reads as such, not as 18446744073709551615.
+    #[test]
+    fn lengths_outside_the_range_and_overflowing_counts_are_refused_readably() {
+        let tiny = Shape::Box { size: [1e-300; 3] };
+        let err = generate_sized(&tiny, tiny.default_sizes(2), 2).unwrap_err().to_string();
+        assert!(err.starts_with("invalid parameter `size x`: 1e-300 m is outside"), "{err}");
+        let huge = Shape::Sphere { radius: 1e9 };
+        assert!(generate_sized(&huge, ElementSizes::uniform(1.0), 2)
+            .unwrap_err()
+            .to_string()
+            .contains("`radius`"));
+        let bar = Shape::Box { size: [0.2, 0.02, 0.01] };
+        for h in [1e300, 1e-300] {
+            let err = generate_sized(&bar, ElementSizes::uniform(h), 2).unwrap_err().to_string();
+            assert!(err.contains("`h`") && err.contains("1e-6 ..= 1e4 m"), "{err}");
+        }
+        let overflow = MeshError::TooManyElements { count: u64::MAX, limit: MAX_GENERATED_TETS }.to_string();
+        assert!(
+            overflow.contains("more than 1.8e19 tets") && !overflow.contains("18446744073709551615"),
+            "{overflow}"
+        );
+        let at_1e_5 = generate_sized(&bar, ElementSizes::uniform(1e-5), 2).unwrap_err().to_string();
+        assert!(at_1e_5.contains("would have 2.400e11 tets"), "{at_1e_5}");
     }
 
     /// The count is what the generator makes, for every shape.
