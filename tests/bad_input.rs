@@ -85,8 +85,17 @@ fn impossible_materials() {
     ] {
         let mut args = vec!["precompute", "good.msh", "-o", "out.bank"];
         args.extend(flags);
-        modal(dir.path(), &args).fails_with(needle);
+        let run = modal(dir.path(), &args).fails_with(needle);
+        assert!(run.stderr.matches("invalid material").count() <= 1, "said twice: {}", run.stderr);
     }
+    // An impossible value is said once; the usage comes with a missing one only.
+    let mut args =
+        vec!["precompute", "good.msh", "-o", "out.bank", "--material", "steel", "--poisson", "0.7"];
+    let run = modal(dir.path(), &args).fails_with("invalid material: Poisson's ratio ν = 0.7");
+    assert!(!run.stderr.contains("use --material NAME"), "{}", run.stderr);
+    args.truncate(4);
+    args.extend(["--youngs", "200e9"]);
+    modal(dir.path(), &args).fails_with("is required when no preset material is given (use --material NAME");
     // A bank written over its own mesh would destroy it.
     modal(dir.path(), &["precompute", "good.msh", "-o", "good.msh", "--material", "steel"])
         .fails_with("input file itself");

@@ -91,6 +91,7 @@ fn bad_strikes_fail_cleanly_without_output() {
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["strike", "missing.bank", at[0], at[1], "-o", "x.wav"], "missing.bank"),
         (vec!["strike", "bar.bank", "--at", "5,5,5", "-o", "x.wav"], "from the surface"),
+        (vec!["strike", "bar.bank", "--mic", "5,5,5", "-o", "x.wav"], "--mic 5,5,5: point"),
         (vec!["strike", "bar.bank", at[0], at[1], "--impulse", "nan", "-o", "x.wav"], "impulse"),
         (vec!["strike", "bar.bank", at[0], at[1], "--rate", "0", "-o", "x.wav"], "sample rate"),
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "-1", "-o", "x.wav"], "duration"),

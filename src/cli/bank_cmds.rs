@@ -57,7 +57,7 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         let range = modal_mesh::SCALE_RANGE;
         anyhow::ensure!(
             range.contains(&gamma),
-            "--scale must be a factor on every length from {:e} to {:e} (got {gamma:e})",
+            "--scale must be a factor on every length from {:e} to {:e} (got {gamma})",
             range.start(),
             range.end()
         );

@@ -1,6 +1,6 @@
 //! `--material` and the explicit `--youngs/--poisson/--density/--alpha/--beta` flags.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use modal_fem::{Material, MaterialOverrides};
 
 use super::args::MaterialArgs;
@@ -14,9 +14,13 @@ pub fn resolve(args: &MaterialArgs) -> Result<(Material, Vec<String>)> {
         alpha: args.alpha,
         beta: args.beta,
     };
-    let resolved = Material::resolve(args.material.as_deref(), &overrides).context(
-        "invalid material (use --material NAME, or all of --youngs PA --poisson NU --density KG_M3)",
-    )?;
+    let resolved = Material::resolve(args.material.as_deref(), &overrides).map_err(|e| match e {
+        // Only a missing value needs the usage; an impossible one says all (once).
+        modal_fem::MaterialError::Missing(_) => {
+            anyhow::anyhow!("{e} (use --material NAME, or all of --youngs PA --poisson NU --density KG_M3)")
+        }
+        other => anyhow::Error::new(other),
+    })?;
     let mut warnings = Vec::new();
     if resolved.damping_defaulted_to_zero {
         warnings.push("no damping given (--alpha/--beta): Rayleigh damping is 0, modes ring forever".into());

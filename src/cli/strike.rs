@@ -171,6 +171,9 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             time_s,
         });
     }
+    if let Some(mic) = args.mic {
+        model.locate(mic).with_context(|| format!("--mic {},{},{}", mic[0], mic[1], mic[2]))?;
+    }
     if let ([at], true) = (at_points.as_slice(), args.at.is_empty()) {
         // Said once the strike is known to be valid, before the slow part.
         eprintln!(

@@ -32,6 +32,9 @@ pub enum BankError {
         #[source]
         source: std::io::Error,
     },
+    /// Another kind of file users mix up with a bank (a mesh, a WAV, a scene).
+    #[error("this is {0}, not a mode bank")]
+    OtherFile(&'static str),
     /// The bytes are not a safetensors file at all.
     #[error("not a safetensors file: {0}")]
     NotSafetensors(String),

@@ -170,6 +170,28 @@ fn load_reports_missing_path_and_directory() {
     assert!(matches!(err, BankError::NotAFile { .. }), "{err}");
 }
 
+/// A mesh, a surface, a WAV or a scene given where a bank goes says what
+/// it is ("header length 8245886857165229348 is implausible" did not).
+#[test]
+fn files_mixed_up_with_a_bank_are_named() {
+    let cases: [(&[u8], &str); 6] = [
+        (b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n", "a Gmsh mesh"),
+        (b"# Blender\nv 0 0 0\nv 1 0 0\nf 1 2 3\n", "an OBJ surface"),
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "an OBJ surface"),
+        (b"solid bar\n  facet normal 0 0 1\n", "an ASCII STL surface"),
+        (b"RIFF\x24\x00\x00\x00WAVEfmt ", "a WAV file"),
+        (b"duration = 1.0\nsample_rate = 48000\n", "a text file"),
+    ];
+    for (bytes, kind) in cases {
+        let err = ModeBank::from_bytes(bytes).unwrap_err();
+        assert!(matches!(err, BankError::OtherFile(_)), "{err:?}");
+        assert!(err.to_string().starts_with(&format!("this is {kind}")), "{err}");
+    }
+    // Unknown bytes keep the plain framing error.
+    let err = ModeBank::from_bytes(&[0xff; 64]).unwrap_err();
+    assert!(matches!(err, BankError::NotSafetensors(_)), "{err:?}");
+}
+
 #[test]
 fn bit_flip_in_tensor_data_is_a_checksum_mismatch() {
     let bytes = linear_bank(3).to_bytes().unwrap();

@@ -31,6 +31,9 @@ fn read_header(bytes: &[u8]) -> Result<(Metadata, &[u8]), BankError> {
     }
     let n = u64::from_le_bytes(prefix);
     if n > MAX_HEADER_BYTES {
+        if let Some(kind) = known_other_file(bytes) {
+            return Err(BankError::OtherFile(kind));
+        }
         return Err(BankError::NotSafetensors(format!("header length {n} is implausible")));
     }
     if 8 + n > actual {
@@ -41,6 +44,36 @@ fn read_header(bytes: &[u8]) -> Result<(Metadata, &[u8]), BankError> {
         Ok((n, meta)) => Ok((meta, bytes.get(8 + n..).unwrap_or_default())),
         Err(e) => Err(BankError::NotSafetensors(e.to_string())),
     }
+}
+
+/// What a file that is not a bank most likely is, from its first bytes: the
+/// inputs and outputs users mix up with a bank (`info bar.msh` said "header
+/// length 8245886857165229348 is implausible").
+fn known_other_file(bytes: &[u8]) -> Option<&'static str> {
+    if bytes.starts_with(b"RIFF") {
+        return Some("a WAV file");
+    }
+    // Up to 512 bytes, cut back to whole UTF-8 characters.
+    let start = &bytes[..bytes.len().min(512)];
+    let text = match std::str::from_utf8(start) {
+        Ok(text) => text,
+        Err(e) => std::str::from_utf8(&start[..e.valid_up_to()]).ok()?,
+    };
+    let text = text.trim_start();
+    let first = text.split_whitespace().next().unwrap_or_default();
+    // An OBJ may open with comments (an exporter's name): any vertex line tells.
+    let obj = text.lines().any(|l| l.starts_with("v ") || l.starts_with("mtllib "));
+    Some(match first {
+        "$MeshFormat" => "a Gmsh mesh (`modal precompute` makes a bank of it)",
+        "solid" => "an ASCII STL surface (`modal precompute` makes a bank of it)",
+        "ply" => "a PLY surface (`modal precompute` makes a bank of it)",
+        "OFF" => "an OFF surface (`modal precompute` makes a bank of it)",
+        _ if obj => "an OBJ surface (`modal precompute` makes a bank of it)",
+        _ if text.starts_with('#') || text.starts_with('[') || text.contains(" = ") => {
+            "a text file (a scene for `modal render`, or a manifest for `modal precompute-batch`?)"
+        }
+        _ => return None,
+    })
 }
 
 /// Checks that the tensor data announced by the header (`n` bytes after the
