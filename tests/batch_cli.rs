@@ -330,6 +330,19 @@ fn a_corrupt_asset_is_reported_while_the_others_complete() {
     let table = modal(d, &["precompute-batch", "library.toml", "--out", "out", "--cache-dir", "cache"], &[]);
     assert!(table.stdout.contains("props/corrupt.msh") && table.stdout.contains("3 ok (3 reused), 2 failed"));
     assert!(table.stderr.contains("warning: props/missing.msh failed"), "{}", table.stderr);
+    // Failed entries keep their bank's name (`id`), so a catalogue with failures merges whole.
+    assert!(entries(&catalogue).iter().all(|e| e["id"].as_str().is_some_and(|id| id.ends_with(".bank"))));
+    let merged = modal(d, &["catalogue", "merge", "out", "-o", "merged/catalogue.json", "--json"], &[]).ok();
+    assert_eq!(
+        (merged.json()["assets"].as_u64(), merged.json()["complete"].as_bool()),
+        (Some(5), Some(true))
+    );
+    // A directory in the way of a bank fails that asset alone, before its solve.
+    std::fs::create_dir_all(d.join("blocked/props/box_00.bank")).unwrap();
+    let blocked =
+        modal(d, &["precompute-batch", "library.toml", "--out", "blocked", "--cache-dir", "cache"], &[]);
+    assert!(blocked.stderr.contains("a directory of that name is in the way"), "{}", blocked.stderr);
+    assert!(blocked.stdout.contains("3 failed"), "{}", blocked.stdout);
 }
 
 #[test]

@@ -89,9 +89,10 @@ fn merge(args: MergeArgs) -> Result<()> {
     if args.json {
         print_json(&summary)
     } else {
+        let n = summary.inputs.len();
         println!(
-            "merged {} catalogues: {} assets ({} failed{}) into {}",
-            summary.inputs.len(),
+            "merged {n} catalogue{}: {} assets ({} failed{}) into {}",
+            if n == 1 { "" } else { "s" },
             summary.assets,
             summary.failed,
             if summary.complete { "" } else { ", incomplete" },

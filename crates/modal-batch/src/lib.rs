@@ -27,13 +27,15 @@ mod catalogue;
 mod fsio;
 mod glob;
 mod manifest;
+mod merge;
 mod run;
 mod shard;
 mod terms;
 
-pub use catalogue::{merge, Catalogue, CatalogueEntry, Library, MergeReport, ShardInfo, CATALOGUE_FILE};
+pub use catalogue::{Catalogue, CatalogueEntry, Library, ShardInfo, CATALOGUE_FILE};
 pub use glob::{expand as expand_glob, Pattern};
 pub use manifest::{Accuracy, Asset, Manifest, Options};
+pub use merge::{merge, MergeReport};
 pub use run::{run_asset, run_batch, BatchOptions, Event, SNAPSHOT_INTERVAL};
 pub use shard::{Shard, ShardEnv, MAX_SHARDS, SHARD_COUNT_ENV};
 

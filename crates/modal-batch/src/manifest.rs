@@ -319,6 +319,19 @@ impl Manifest {
             origin.insert(asset.bank.clone(), table);
             by_bank.insert(asset.bank.clone(), asset);
         }
+        // A bank named like a directory another bank needs (`props` beside
+        // `props/cup.bank`): one of the two could not be written.
+        for bank in by_bank.keys() {
+            if let Some(inside) = by_bank.range(format!("{bank}/")..).next().map(|(b, _)| b) {
+                if inside.starts_with(&format!("{bank}/")) {
+                    return Err(self.error(format!(
+                        "{} writes bank '{bank}', a file where {} needs a directory for '{inside}': give one \
+                         of them another `bank = \"…\"`",
+                        origin[bank], origin[inside]
+                    )));
+                }
+            }
+        }
         Ok((by_bank.into_values().collect(), warnings))
     }
 
@@ -593,6 +606,16 @@ mod tests {
             assert!(check_bank_name(name).unwrap_err().contains("catalogue"), "{name}");
         }
         assert_eq!(check_bank_name("sub/catalogue.json").unwrap(), "sub/catalogue.json");
+    }
+
+    #[test]
+    fn a_bank_named_like_another_banks_directory_is_refused() {
+        let text = "[defaults]\nmaterial = \"steel\"\n[[assets]]\npath = \"a.obj\"\nbank = \"props\"\n\
+                    [[assets]]\npath = \"props/cup.obj\"\n[[assets]]\npath = \"propsx/cup.obj\"";
+        let e = resolve(text, Path::new(".")).unwrap_err().to_string();
+        assert!(e.contains("writes bank 'props', a file where") && e.contains("'props/cup.bank'"), "{e}");
+        let apart = text.replace("bank = \"props\"", "bank = \"props.bank\"");
+        assert!(resolve(&apart, Path::new(".")).is_ok(), "'props.bank' and 'propsx/' need no 'props/'");
     }
 
     #[test]

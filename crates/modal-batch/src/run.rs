@@ -20,7 +20,7 @@
 //! run killed in between lists its last assets as pending; a re-run finds
 //! their banks finished.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -84,15 +84,15 @@ pub fn run_batch(
     on_event: &(dyn Fn(Event<'_>) + Sync),
 ) -> Result<Catalogue, BatchError> {
     let path = options.out_dir.join(Catalogue::file_name(options.shard));
-    let pending: Vec<String> = assets.iter().map(|a| a.path.clone()).collect();
-    let catalogue_of = |done: Vec<CatalogueEntry>, pending: Vec<String>| Catalogue {
+    let pending: Vec<(String, String)> = assets.iter().map(|a| (a.path.clone(), a.bank.clone())).collect();
+    let catalogue_of = |done: Vec<CatalogueEntry>, pending: Vec<(String, String)>| Catalogue {
         library: options.library.clone(),
         ..Catalogue::new(done, pending, options.shard)
     };
     catalogue_of(Vec::new(), pending.clone()).save(&path)?;
     struct State {
         done: Vec<CatalogueEntry>,
-        pending: Vec<String>,
+        pending: Vec<(String, String)>,
         write_error: Option<BatchError>,
         saved: Instant,
     }
@@ -106,7 +106,8 @@ pub fn run_batch(
         {
             let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
             s.done.push(entry.clone());
-            if let Some(at) = s.pending.iter().position(|p| *p == asset.path) {
+            // By bank: one file listed twice (two materials) is two assets.
+            if let Some(at) = s.pending.iter().position(|(_, bank)| *bank == asset.bank) {
                 s.pending.remove(at);
             }
             if s.saved.elapsed() >= SNAPSHOT_INTERVAL {
@@ -164,6 +165,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> CatalogueEntry {
             CatalogueEntry {
                 path: asset.path.clone(),
                 bank: Some(asset.bank.clone()),
+                id: asset.bank.clone(),
                 hash: Some(bank.info.input_hash.clone()),
                 modes: bank.frequencies_hz.len(),
                 first_frequency_hz: bank.frequencies_hz.first().copied(),
@@ -179,6 +181,7 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> CatalogueEntry {
         Err(status) => CatalogueEntry {
             path: asset.path.clone(),
             bank: None,
+            id: asset.bank.clone(),
             hash,
             modes: 0,
             first_frequency_hz: None,
@@ -191,6 +194,19 @@ pub fn run_asset(asset: &Asset, options: &BatchOptions) -> CatalogueEntry {
             warnings,
         },
     }
+}
+
+/// Makes the directory of the bank `out` and checks that a file can be made
+/// there and that `out` is no directory (another asset's bank may need one
+/// by that name): the asset fails at once, not after its solve.
+fn writable(out: &Path) -> Result<(), String> {
+    let dir = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    if out.is_dir() {
+        return Err(format!("cannot write bank {}: a directory of that name is in the way", out.display()));
+    }
+    let probe = tempfile::Builder::new().prefix(".modal-probe-").tempfile_in(dir);
+    probe.map(drop).map_err(|e| format!("cannot write bank {}: {e}", out.display()))
 }
 
 /// An asset's bank as written to the output directory.
@@ -233,6 +249,8 @@ fn solve(
             }
         }
     }
+    // Where the bank goes is made ready before the solve, not found unwritable after it.
+    writable(&out)?;
     let outcome = modal_precompute::precompute(request, options.cache.as_ref(), options.force, &mut |_| {})
         .map_err(|e| in_manifest_terms(&chain(&e)))?;
     warnings.extend(outcome.warnings.iter().map(|w| format!("{}: {}", asset.path, in_manifest_terms(w))));
@@ -241,9 +259,6 @@ fn solve(
             .map_err(|e| format!("acoustic transfer: {}", chain(&e)))?,
         None => None,
     };
-    if let Some(dir) = out.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    }
     let written = match &table {
         Some(t) => outcome.bank.save_with_radiation(&out, t),
         None => outcome.bank.save(&out),
