@@ -383,6 +383,9 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert!(info["modes"][0]["radiated_power_w"].is_null(), "modes not solved stay null");
     let table_text = modal(dir.path(), &["info", "rad.bank"]).ok().stdout;
     assert!(table_text.contains("radiated W"), "{table_text}");
+    // Without --point the table has no level column to leave empty.
+    let no_points = modal(dir.path(), &["radiation", "rad.bank", "--mode", "5"]).ok().stdout;
+    assert!(!no_points.contains("level at each point"), "{no_points}");
     // One more mode adds to the stored transfer; the others are kept bit for bit.
     modal(dir.path(), &["radiation", "rad.bank", "--mode", "7", "--store", "more.bank"]).ok();
     let (_, more) = ModeBank::load_with_radiation(dir.path().join("more.bank")).unwrap();
@@ -401,7 +404,8 @@ fn stored_far_field_matches_the_solve_and_info_shows_power() {
     assert_eq!(c.unwrap().modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [7]);
     // Retuned to twice the size (every ka kept) the transfer is rescaled, and
     // agrees with a new solve of the retuned bank; a damping change keeps it.
-    modal(dir.path(), &["retune", "rad.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    let retuned = modal(dir.path(), &["retune", "rad.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    assert!(retuned.stdout.contains("radiated W"), "retune shows what it wrote: {}", retuned.stdout);
     let far2 = far.map(|x| 2.0 * x);
     let p2 = format!("{},{},{}", far2[0], far2[1], far2[2]);
     let resolved = modal(

@@ -22,10 +22,6 @@ pub fn load_bank_with_radiation(path: &std::path::Path) -> Result<(ModeBank, Opt
     ModeBank::load_with_radiation(path).with_context(|| format!("cannot load bank {}", path.display()))
 }
 
-fn show(bank: &ModeBank, json: bool) -> Result<()> {
-    show_with(bank, None, json)
-}
-
 fn show_with(bank: &ModeBank, radiation: Option<&RadiationTable>, json: bool) -> Result<()> {
     let report = BankJson::new(bank, false).with_radiation(radiation);
     if json {
@@ -85,7 +81,7 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         None => new.save(&args.out),
     })
     .with_context(|| format!("cannot write bank {}", args.out.display()))?;
-    show(&new, args.json)?;
+    show_with(&new, transfer.as_ref(), args.json)?;
     if !args.json {
         println!("wrote {}", args.out.display());
     }

@@ -193,8 +193,10 @@ pub fn run(args: RadiationArgs) -> Result<()> {
     if args.json {
         return print_json(&report);
     }
+    // The level column only when there are points (--point) to show.
+    let level_header = if args.point.is_empty() { "" } else { "  level at each point [dB SPL]" };
     println!(
-        "{:>5} {:>11} {:>12} {:>10} {:>5}  level at each point [dB SPL]",
+        "{:>5} {:>11} {:>12} {:>10} {:>5}{level_header}",
         "mode", "freq [Hz]", "power [W]", "efficiency", "order"
     );
     for m in &report.modes {
@@ -206,14 +208,10 @@ pub fn run(args: RadiationArgs) -> Result<()> {
                 format!("{:.1}", 20.0 * (rms / 20e-6).log10())
             })
             .collect();
+        let levels = if levels.is_empty() { String::new() } else { format!("  {}", levels.join(" ")) };
         println!(
-            "{:>5} {:>11.2} {:>12.4e} {:>10.3e} {:>5}  {}",
-            m.index,
-            m.frequency_hz,
-            m.radiated_power_w,
-            m.radiation_efficiency,
-            m.multipole_order,
-            levels.join(" ")
+            "{:>5} {:>11.2} {:>12.4e} {:>10.3e} {:>5}{levels}",
+            m.index, m.frequency_hz, m.radiated_power_w, m.radiation_efficiency, m.multipole_order,
         );
     }
     Ok(())

@@ -248,8 +248,9 @@ pub struct GeneratorSpec {
     /// Box edge lengths [m] (`box`).
     #[serde(default)]
     pub size: Option<[f64; 3]>,
-    /// Outer radius [m] (`cylinder`, `tube`, `sphere`, `bowl`).
-    #[serde(default)]
+    /// Outer radius [m] (`cylinder`, `tube`, `sphere`, `bowl`); also
+    /// `outer_radius`, the name `modal mesh tube --outer-radius` gives it.
+    #[serde(default, alias = "outer_radius")]
     pub radius: Option<f64>,
     /// Inner radius [m] (`tube`).
     #[serde(default)]

@@ -126,6 +126,19 @@ fn mesh_paths_presets_and_material_tables_still_parse() {
     assert_eq!(ground.material, modal_scene::MaterialSpec::Preset("Glass".into()));
 }
 
+/// `modal mesh tube --outer-radius` names the key `radius` of a scene's
+/// tube: both spellings give one tube; both at once is a duplicate.
+#[test]
+fn a_tube_takes_the_cli_name_of_its_outer_radius() {
+    let tube = |keys: &str| {
+        let mesh = format!("mesh = {{ generate = \"tube\", inner_radius = 0.01, {keys}, length = 0.3 }}");
+        Scene::from_toml_str(&scene(&mesh, STEEL, ""), Path::new("."))
+    };
+    let (a, b) = (tube("radius = 0.015").unwrap(), tube("outer_radius = 0.015").unwrap());
+    assert_eq!(a.objects[0].mesh, b.objects[0].mesh);
+    assert!(tube("radius = 0.015, outer_radius = 0.015").is_err());
+}
+
 #[test]
 fn valid_rotations_parse_to_the_same_quaternion_as_before() {
     let close = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
