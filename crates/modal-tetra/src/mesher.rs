@@ -339,7 +339,9 @@ pub fn tetrahedralize(
     let tris: Vec<[V3; 3]> = repaired.triangles.iter().map(|t| t.map(|v| repaired.vertices[v])).collect();
     let bvh = Bvh::new(tris);
     let mut warnings: Vec<String> = slab_warning.into_iter().collect();
-    let layered = try_layered(&repaired, &bvh, options, (diagonal, volume, area), &mut warnings)?;
+    let mut not_layered = None;
+    let layered =
+        try_layered(&repaired, &bvh, options, (diagonal, volume, area), &mut warnings, &mut not_layered)?;
     let (mut stuffed, h, thin_samples, min_thickness_m, wall_layers, smoothed) = match layered {
         Some(LayeredWall { mesh: l, smoothed }) => {
             let stuffed = Stuffed { nodes: l.nodes, tets: l.tets, dropped: 0, min_cell: l.shortest_edge_m };
@@ -348,6 +350,12 @@ pub fn tetrahedralize(
         None => {
             let (stuffed, h, thin_samples, min_thickness_m) =
                 stuff_surface(&repaired, &bvh, options, (lo, hi), (h0, diagonal, volume), &mut warnings)?;
+            // Why it was not layered matters when the stuffing costs more than
+            // a default mesh (a mug with a handle); a solid bar of 9 k tets
+            // was told its "thin walls" made it slower, which they did not.
+            if stuffed.tets.len() > DEFAULT_MAX_TETS {
+                warnings.extend(not_layered.take());
+            }
             (stuffed, h, thin_samples, min_thickness_m, 0, None)
         }
     };
@@ -449,13 +457,15 @@ pub const LAYERED_CELL_PER_WALL: f64 = 2.0;
 pub const LAYERED_STRAIGHT_CELL_PER_WALL: f64 = 16.0;
 
 /// The thin-shell mesh of the surface (module `shell`) when its wall is
-/// thinner than the cell asks for and it is a shell; `None`: stuff it.
+/// thinner than the cell asks for and it is a shell; `None`: stuff it, with
+/// why in `not_layered` when it was tried (said if the stuffing is costly).
 fn try_layered(
     repaired: &Repaired,
     bvh: &Bvh,
     options: &TetOptions,
     (diagonal, volume, area): (f64, f64, f64),
     warnings: &mut Vec<String>,
+    not_layered: &mut Option<String>,
 ) -> Result<Option<LayeredWall>, TetraError> {
     if options.graded || options.target_tets.is_some() || !(volume > 0.0 && area > 0.0) {
         return Ok(None);
@@ -504,7 +514,7 @@ fn try_layered(
             Err(_) => {}
         }
     }
-    warnings.push(not_layered_warning(&reason, wall));
+    *not_layered = Some(not_layered_warning(&reason, wall));
     Ok(None)
 }
 

@@ -292,6 +292,16 @@ fn a_plate_exported_as_twelve_triangles_is_refined_to_the_wall_rule() {
     assert!(sizes[2] < sizes[0], "more modes, finer plate: {sizes:?}");
 }
 
+/// The README's steel bar (0.3 × 0.02 × 0.01 m) is a solid, stuffed within
+/// the default budget: it is not told that its "thin walls" made it slower.
+#[test]
+fn a_solid_bar_is_stuffed_without_a_thin_wall_warning() {
+    let bar = shapes::cuboid(0.3, 0.02, 0.01);
+    let (_, report) = tetrahedralize(&bar, &TetOptions { curved: false, ..Default::default() }).unwrap();
+    assert!(report.wall_layers == 0 && report.tets <= modal_tetra::DEFAULT_MAX_TETS, "{report:?}");
+    assert!(report.warnings.iter().all(|w| !w.contains("not meshed in layers")), "{:?}", report.warnings);
+}
+
 #[test]
 fn a_mug_with_a_handle_is_not_a_shell_and_is_stuffed() {
     // The handle's tube faces itself: its skins do not pair two by two.
