@@ -228,6 +228,16 @@ fn a_scene_object_can_name_a_gltf_bank() {
     assert!(a["objects"][0]["impacts"].as_u64().unwrap() >= 1, "{a}");
     let wav = std::fs::read(dir.path().join("a.wav")).unwrap();
     assert_eq!(std::fs::read(dir.path().join("b.wav")).unwrap(), wav);
+    // Named as a mesh, a glTF with a modal model is that bank too (it was
+    // re-meshed from its surface and solved anew, without a word), retuned
+    // to the object's material: here the bank's own, so the same sound.
+    let same = "material = { youngs = 200e9, poisson = 0.3, density = 7850, alpha = 5, beta = 3e-8 }";
+    let as_mesh = scene("bar.glb").replace("bank = \"bar.glb\"", &format!("mesh = \"bar.glb\"\n{same}"));
+    std::fs::write(dir.path().join("c.toml"), as_mesh).unwrap();
+    let said = modal(dir.path(), &["render", "c.toml", "-o", "c.wav", "--json"]).ok();
+    assert!(said.stderr.contains("holds a modal model: used as the object's bank"), "{}", said.stderr);
+    assert_eq!(said.json()["banks_solved"].as_u64(), Some(0), "{}", said.stdout);
+    assert_eq!(std::fs::read(dir.path().join("c.wav")).unwrap(), wav);
 }
 
 #[test]

@@ -103,6 +103,17 @@ impl BankProvider for PipelineProvider<'_> {
             return Ok(Arc::new(ModeBank::load(path)?));
         }
         let mesh = request.mesh.as_ref().ok_or("the object names neither a mesh nor a bank")?;
+        if let modal_scene::MeshSource::File(path) = mesh {
+            // A glTF holding a modal model is a bank, as `modal precompute` reads it.
+            if modal_export::gltf::is_gltf_path(path) && modal_export::gltf::holds_modal_model(path)? {
+                self.warnings.push(format!(
+                    "{}: holds a modal model: used as the object's bank, retuned to its material \
+                     (`bank = ...` says so without this warning)",
+                    path.display()
+                ));
+                return self.retuned_bank_file(request, path).map(Arc::new);
+            }
+        }
         let material = request.material.clone().ok_or("an object given as a mesh needs a material")?;
         let what = describe(mesh);
         let source = match mesh {
@@ -177,16 +188,16 @@ impl BankProvider for PipelineProvider<'_> {
             (None, Some(path)) => path.display().to_string(),
             (None, None) => return Ok(None),
         };
-        if let Some(path) = &request.bank {
-            if let Some((_, table)) = self.retuned.iter().find(|(r, _)| r == request) {
-                if table.is_none() {
-                    self.warnings.push(format!(
-                        "{what}, retuned to the object's material: no stored transfer carries over (E/ρ moved \
-                         every mode to a new ka): its level is a pulsating-sphere estimate"
-                    ));
-                }
-                return Ok(table.clone().map(Arc::new));
+        if let Some((_, table)) = self.retuned.iter().find(|(r, _)| r == request) {
+            if table.is_none() {
+                self.warnings.push(format!(
+                    "{what}, retuned to the object's material: no stored transfer carries over (E/ρ moved \
+                     every mode to a new ka, or it had none): its level is a pulsating-sphere estimate"
+                ));
             }
+            return Ok(table.clone().map(Arc::new));
+        }
+        if let Some(path) = &request.bank {
             let table = super::listener::stored_radiation(path)?;
             if table.is_none() {
                 self.warnings.push(format!(
