@@ -192,22 +192,65 @@ fn progress_bar(len: u64, prefix: &str) -> ProgressBar {
     bar
 }
 
-/// The summary table: one line per asset, failures with their message.
+/// The summary table: one line per asset, failures with their message. A
+/// file listed more than once (two materials) is told apart by its bank.
 fn write_table(catalogue: &Catalogue, out: &mut impl Write) -> std::io::Result<()> {
-    let width = catalogue.assets.iter().map(|e| e.path.len()).max().unwrap_or(4).max(4);
+    let listed = |path: &str| catalogue.assets.iter().filter(|e| e.path == path).count();
+    let labels: Vec<String> = catalogue
+        .assets
+        .iter()
+        .map(|e| if listed(&e.path) > 1 { format!("{} ({})", e.path, e.id) } else { e.path.clone() })
+        .collect();
+    let width = labels.iter().map(|l| l.chars().count()).max().unwrap_or(4).max(4);
     writeln!(
         out,
         "{:<width$}  {:>5}  {:>10}  {:>8}  {:>8}  {:<6}  status",
         "path", "modes", "f1 [Hz]", "transfer", "seconds", "reused"
     )?;
-    for e in &catalogue.assets {
+    for (e, label) in catalogue.assets.iter().zip(&labels) {
         let f1 = e.first_frequency_hz.map_or("-".to_string(), |f| format!("{f:.1}"));
         let reused = if e.cached { "yes" } else { "no" };
         writeln!(
             out,
-            "{:<width$}  {:>5}  {f1:>10}  {:>8}  {:>8.2}  {reused:<6}  {}",
-            e.path, e.modes, e.transfer_modes, e.seconds, e.status
+            "{label:<width$}  {:>5}  {f1:>10}  {:>8}  {:>8.2}  {reused:<6}  {}",
+            e.modes, e.transfer_modes, e.seconds, e.status
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file listed twice (two materials) shows its bank; a file listed once does not.
+    #[test]
+    fn the_table_tells_two_banks_of_one_file_apart() {
+        let entry = |path: &str, id: &str| modal_batch::CatalogueEntry {
+            path: path.into(),
+            bank: Some(id.into()),
+            id: id.into(),
+            hash: None,
+            modes: 4,
+            first_frequency_hz: Some(100.0),
+            transfer_modes: 0,
+            seconds: 1.0,
+            status: "ok".into(),
+            cached: false,
+            mass_kg: None,
+            size_m: None,
+            warnings: Vec::new(),
+        };
+        let assets = vec![
+            entry("cup.obj", "cup.bank"),
+            entry("cup.obj", "cup_glass.bank"),
+            entry("rod.obj", "rod.bank"),
+        ];
+        let catalogue = Catalogue::new(assets, Vec::new(), modal_batch::Shard::WHOLE);
+        let mut out = Vec::new();
+        write_table(&catalogue, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.contains("cup.obj (cup.bank) ") && text.contains("cup.obj (cup_glass.bank) "), "{text}");
+        assert!(text.contains("\nrod.obj ") && !text.contains("rod.obj (rod.bank)"), "{text}");
+    }
 }

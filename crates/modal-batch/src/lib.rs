@@ -61,13 +61,13 @@ pub enum BatchError {
         source: std::io::Error,
     },
     /// The manifest is not valid TOML or has unknown keys.
-    #[error("manifest {path}: {source}")]
+    #[error("manifest {path}: {message}")]
     Toml {
         /// The manifest.
         path: String,
-        /// The parser's message (with line and column).
-        #[source]
-        source: Box<toml::de::Error>,
+        /// The parser's message and where, on one line (its caret diagram
+        /// printed squashed into the error line).
+        message: String,
     },
     /// The manifest parses but says something impossible.
     #[error("manifest {path}: {message}")]

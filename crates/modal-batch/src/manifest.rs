@@ -225,8 +225,10 @@ pub struct Asset {
 impl Manifest {
     /// Parses manifest text; `base` is the directory paths are relative to.
     pub fn parse(text: &str, source: &str, base: &Path) -> Result<Manifest, BatchError> {
-        let file: ManifestFile = toml::from_str(text)
-            .map_err(|e| BatchError::Toml { path: source.to_string(), source: Box::new(e) })?;
+        let file: ManifestFile = toml::from_str(text).map_err(|e| BatchError::Toml {
+            path: source.to_string(),
+            message: located(e.message(), e.span().map(|span| line_and_column(text, span.start))),
+        })?;
         Ok(Manifest { file, source: source.to_string(), base: base.to_path_buf() })
     }
 
@@ -438,6 +440,21 @@ fn normalize(path: &str) -> String {
     }
 }
 
+/// `message (at line L, column C)`, 1-based.
+fn located(message: &str, at: Option<(usize, usize)>) -> String {
+    match at {
+        Some((line, column)) => format!("{} (at line {line}, column {column})", message.trim()),
+        None => message.trim().to_string(),
+    }
+}
+
+/// The 1-based line and column (in characters) of byte `offset` of `text`.
+fn line_and_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = text.get(..offset).unwrap_or(text);
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    (before.matches('\n').count() + 1, before[line_start..].chars().count() + 1)
+}
+
 /// The default bank name of an asset: its path with the extension replaced
 /// by `.bank`, `..` segments written `_up_` and a leading `/` dropped, so the
 /// bank always lands inside the output directory.
@@ -606,6 +623,17 @@ mod tests {
             assert!(check_bank_name(name).unwrap_err().contains("catalogue"), "{name}");
         }
         assert_eq!(check_bank_name("sub/catalogue.json").unwrap(), "sub/catalogue.json");
+    }
+
+    /// A manifest's TOML error is one line with where it is (its caret
+    /// diagram was squashed into the error line).
+    #[test]
+    fn a_manifest_typo_is_one_line_with_its_place() {
+        let text = "# ünïcode first\n[defaults]\nmaterial = \"steel\"\n  modse = 4\n";
+        let e = resolve(text, Path::new(".")).unwrap_err().to_string();
+        assert!(!e.contains('\n') && !e.contains('|') && !e.contains('^'), "{e}");
+        assert!(e.contains("unknown field `modse`") && e.ends_with("(at line 4, column 3)"), "{e}");
+        assert_eq!(line_and_column("aé\nbc", 5), (2, 2));
     }
 
     #[test]
