@@ -332,3 +332,29 @@ fn material_and_scale_on_a_bank_object_retune_it() {
     let (big, _) = wav("big", "bank = \"big.bank\"");
     assert!(twice == big && twice != steel, "the scale was ignored");
 }
+
+/// Ctrl-C (SIGINT) of a `--json` run: exit 130, `{"error": "interrupted"}`
+/// on stdout like any other failure (stdout was empty), no output file and
+/// no directory the run made for it. Interrupted a second into the demo's
+/// cold solves, which take several.
+#[test]
+fn an_interrupted_json_run_says_so_on_stdout_and_leaves_nothing() {
+    let dir = temp_dir();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_modal"))
+        .args(["render", "-o", "out/demo.wav", "--json"])
+        .current_dir(dir.path())
+        .env("MODAL_CACHE_DIR", dir.path().join("cache"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    let sent = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(sent.success());
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(130), "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+    let json: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
+    assert_eq!(json["error"], "interrupted");
+    assert!(!dir.path().join("out").exists(), "the directory made for the WAV is left");
+}

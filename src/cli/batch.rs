@@ -102,6 +102,11 @@ pub fn run(args: PrecomputeBatchArgs) -> Result<()> {
         ShardEnv::Kubernetes => format!("shard {shard} (JOB_COMPLETION_INDEX): "),
     };
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
+    anyhow::ensure!(
+        !args.out.exists() || args.out.is_dir(),
+        "--out {} is a file: give the directory the banks and the catalogue go to",
+        args.out.display()
+    );
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let options = BatchOptions {
         out_dir: args.out.clone(),

@@ -14,10 +14,15 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::SeqCst};
 
 static WRITES_IN_PROGRESS: AtomicUsize = AtomicUsize::new(0);
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// The command was given `--json`: its stdout holds one object, an error too.
+static JSON: AtomicBool = AtomicBool::new(false);
 
 fn exit_interrupted() -> ! {
     super::files::remove_made_directories();
     eprintln!("error: interrupted");
+    if JSON.load(SeqCst) && !super::output::json_printed() {
+        println!("{}", serde_json::json!({ "error": "interrupted" }));
+    }
     std::process::exit(130)
 }
 
@@ -25,8 +30,10 @@ fn exit_interrupted() -> ! {
 /// process anyway (a write stuck on a dead network file system).
 const WRITE_WAIT: std::time::Duration = std::time::Duration::from_secs(30);
 
-/// Installs the SIGINT/SIGTERM handler (once, at start-up).
-pub fn install() {
+/// Installs the SIGINT/SIGTERM handler (once, at start-up); `json`: the
+/// command prints JSON, so an interrupt is `{"error": "interrupted"}` there.
+pub fn install(json: bool) {
+    JSON.store(json, SeqCst);
     // If a handler cannot be installed, Ctrl-C keeps its default behaviour.
     // The handler runs on its own thread, so it can wait for the writes.
     let _ = ctrlc::set_handler(|| {

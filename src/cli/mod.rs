@@ -36,7 +36,7 @@ pub fn run() -> ExitCode {
     // `--json` is a flag of every command that has it, never an option's value.
     let json = std::env::args_os().any(|a| a == "--json");
     let cli = Cli::try_parse().unwrap_or_else(|err| malformed(err, json));
-    interrupt::install();
+    interrupt::install(json);
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,

@@ -15,7 +15,7 @@ pub fn print_error(err: &anyhow::Error, json: bool) {
     }
     let line = line.replace('\n', " ");
     eprintln!("error: {line}");
-    if json && !JSON_PRINTED.load(std::sync::atomic::Ordering::SeqCst) {
+    if json && !json_printed() {
         // A script reading the JSON on stdout gets the failure there too.
         println!("{}", serde_json::json!({ "error": line }));
     }
@@ -36,6 +36,11 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
 /// Whether a JSON document went to stdout (a batch's report precedes its
 /// failure exit): the error is then not printed as a second document.
 static JSON_PRINTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// True once a JSON document went to stdout.
+pub fn json_printed() -> bool {
+    JSON_PRINTED.load(std::sync::atomic::Ordering::SeqCst)
+}
 
 /// Prints `value` as one JSON document on stdout.
 pub fn print_json(value: &impl serde::Serialize) -> anyhow::Result<()> {

@@ -227,7 +227,7 @@ impl Manifest {
     pub fn parse(text: &str, source: &str, base: &Path) -> Result<Manifest, BatchError> {
         let file: ManifestFile = toml::from_str(text).map_err(|e| BatchError::Toml {
             path: source.to_string(),
-            message: located(e.message(), e.span().map(|span| line_and_column(text, span.start))),
+            message: located(e.message(), e.span().map(|span| (line_and_column(text, span.start), text))),
         })?;
         Ok(Manifest { file, source: source.to_string(), base: base.to_path_buf() })
     }
@@ -440,12 +440,12 @@ fn normalize(path: &str) -> String {
     }
 }
 
-/// `message (at line L, column C)`, 1-based.
-fn located(message: &str, at: Option<(usize, usize)>) -> String {
-    match at {
-        Some((line, column)) => format!("{} (at line {line}, column {column})", message.trim()),
-        None => message.trim().to_string(),
-    }
+/// `message (at line L, column C: the line)`, 1-based, the line as written
+/// (it names the key a wrong value belongs to).
+fn located(message: &str, at: Option<((usize, usize), &str)>) -> String {
+    let Some(((line, column), text)) = at else { return message.trim().to_string() };
+    let written: String = text.lines().nth(line - 1).unwrap_or_default().trim().chars().take(80).collect();
+    format!("{} (at line {line}, column {column}: `{written}`)", message.trim())
 }
 
 /// The 1-based line and column (in characters) of byte `offset` of `text`.
@@ -477,10 +477,22 @@ pub(crate) fn bank_name(path: &str) -> String {
 
 /// Checks a `bank = "…"` name: relative, inside the output directory.
 fn check_bank_name(name: &str) -> Result<String, String> {
-    let n = normalize(name);
+    let outside = || format!("`bank = \"{name}\"` must be a relative path inside the output directory");
+    // `x/../rod.bank` stays inside: `..` undoes the part before it, if any.
+    let mut inside: Vec<&str> = Vec::new();
+    let normalized = normalize(name);
+    for part in normalized.split('/') {
+        match part {
+            ".." => {
+                inside.pop().ok_or_else(outside)?;
+            }
+            _ => inside.push(part),
+        }
+    }
+    let n = inside.join("/");
     let escapes = Path::new(&n).components().any(|c| !matches!(c, Component::Normal(_)));
-    if n.is_empty() || escapes {
-        return Err(format!("`bank = \"{name}\"` must be a relative path inside the output directory"));
+    if n.is_empty() || escapes || normalized.starts_with('/') {
+        return Err(outside());
     }
     // The catalogue would overwrite the bank (and be listed as it).
     if n == crate::CATALOGUE_FILE || crate::catalogue::parse_shard_name(&n).is_some() {
@@ -623,6 +635,14 @@ mod tests {
             assert!(check_bank_name(name).unwrap_err().contains("catalogue"), "{name}");
         }
         assert_eq!(check_bank_name("sub/catalogue.json").unwrap(), "sub/catalogue.json");
+        // `..` that stays inside is followed; one that leaves, or an absolute path, is not.
+        assert_eq!(check_bank_name("x/./y/../rod.bank").unwrap(), "x/rod.bank");
+        for outside in ["../rod.bank", "x/../../rod.bank", "/abs/rod.bank", "x/.."] {
+            assert!(
+                check_bank_name(outside).unwrap_err().contains("inside the output directory"),
+                "{outside}"
+            );
+        }
     }
 
     /// A manifest's TOML error is one line with where it is (its caret
@@ -632,7 +652,10 @@ mod tests {
         let text = "# ünïcode first\n[defaults]\nmaterial = \"steel\"\n  modse = 4\n";
         let e = resolve(text, Path::new(".")).unwrap_err().to_string();
         assert!(!e.contains('\n') && !e.contains('|') && !e.contains('^'), "{e}");
-        assert!(e.contains("unknown field `modse`") && e.ends_with("(at line 4, column 3)"), "{e}");
+        assert!(
+            e.contains("unknown field `modse`") && e.ends_with("(at line 4, column 3: `modse = 4`)"),
+            "{e}"
+        );
         assert_eq!(line_and_column("aé\nbc", 5), (2, 2));
     }
 

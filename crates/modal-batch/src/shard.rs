@@ -130,7 +130,16 @@ impl Shard {
         let count_from_env = number(SHARD_COUNT_ENV)?;
         if let Some(id) = number("SLURM_ARRAY_TASK_ID")? {
             let min = number("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
-            let n = match count.or(number("SLURM_ARRAY_TASK_COUNT")?).or(count_from_env) {
+            let tasks = number("SLURM_ARRAY_TASK_COUNT")?;
+            if let Some((shards, tasks)) = count.zip(tasks).filter(|(c, t)| c != t) {
+                // The range check below would blame an index list that was never used.
+                return Err(BatchError::Shard(format!(
+                    "--shard-count {shards} disagrees with the Slurm array's SLURM_ARRAY_TASK_COUNT {tasks}: \
+                     one task per shard needs the same count (drop --shard-count, or submit --array with \
+                     {shards} tasks)"
+                )));
+            }
+            let n = match count.or(tasks).or(count_from_env) {
                 Some(n) => n,
                 None => {
                     return Err(BatchError::Shard(
@@ -294,6 +303,13 @@ mod tests {
         let mut range = stepped("6").to_vec();
         range.push(("SLURM_ARRAY_TASK_MAX", "14"));
         assert_eq!(Shard::select(None, None, env(&range)).unwrap().0, Shard::new(3, 8).unwrap());
+        // --shard-count against the array's own count: said as such, not as an index list.
+        let err = Shard::select(None, Some(5), env(&range)).unwrap_err().to_string();
+        assert!(
+            err.starts_with("--shard-count 5 disagrees with the Slurm array's SLURM_ARRAY_TASK_COUNT 8"),
+            "{err}"
+        );
+        assert_eq!(Shard::select(None, Some(8), env(&range)).unwrap().0, Shard::new(3, 8).unwrap());
     }
 
     #[test]
