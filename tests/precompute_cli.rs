@@ -339,6 +339,38 @@ fn a_default_surface_mesh_beyond_the_memory_guard_is_coarsened_to_fit_and_not_ca
     assert_eq!(again.json()["cached"], Value::Bool(false), "a coarsened bank is not served from the cache");
 }
 
+/// A first level coarsened to fit the memory guard that falls apart is
+/// refused before its solve: a dumbbell (two 4 cm discs on a 6 mm neck, one
+/// surface) is one body at the defaults; under a 0.05 GB guard, at × 2.3
+/// cells, its neck is gone and it would ring as two loose pieces (a wine
+/// glass of 1.5 mm wall came out in six).
+#[test]
+fn a_mesh_that_falls_apart_when_coarsened_for_memory_is_refused() {
+    let dir = temp_dir();
+    let profile = [
+        (0.0, 0.0),
+        (0.02, 0.0),
+        (0.02, 0.04),
+        (0.003, 0.04),
+        (0.003, 0.10),
+        (0.02, 0.10),
+        (0.02, 0.14),
+        (0.0, 0.14),
+    ];
+    let surface = modal_tetra::shapes::revolve(&profile, 32, "dumbbell");
+    let mut obj = Vec::new();
+    modal_tetra::write_obj(&surface, &mut obj).unwrap();
+    std::fs::write(dir.path().join("dumbbell.obj"), obj).unwrap();
+    let base =
+        ["precompute", "dumbbell.obj", "--material", "steel", "--no-cache", "--accuracy", "off", "--json"];
+    let whole = modal(dir.path(), &[&base[..], &["-o", "a.bank"]].concat()).ok().json();
+    assert_eq!(whole["rigid_modes_removed"].as_u64(), Some(6), "one body at the defaults");
+    let run = modal_within_memory(dir.path(), &[&base[..], &["-o", "b.bank"]].concat(), "0.05");
+    let run = run.fails_with("falls apart into 2 parts (the surface is 1 body)");
+    assert!(run.stderr.contains("to fit the memory limit"), "{}", run.stderr);
+    assert!(!dir.path().join("b.bank").exists());
+}
+
 #[test]
 fn a_mesh_whose_factor_exceeds_the_memory_guard_is_refused_before_its_matrices_are_assembled() {
     // A 5 cm cube at 4 mm, 59 k DOF: K and M ≈ 0.2 GB fit 0.3 GB, their factor (≈ 0.4 GB)

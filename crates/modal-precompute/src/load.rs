@@ -66,6 +66,9 @@ pub struct LoadedMesh {
     pub cell_m: Option<f64>,
     /// The surface was meshed in layers across a thin wall (`TetReport::wall_layers` > 0).
     pub layered: bool,
+    /// Separate bodies of the input surface (its components, a hollow body's
+    /// inner wall not counted); `None` for a tet mesh.
+    pub surface_bodies: Option<usize>,
 }
 
 /// How a discretization level (`crate::levels`) sizes a surface mesh's tets.
@@ -201,11 +204,12 @@ pub(crate) fn load_mesh_sized(
         return Err(PrecomputeError::Invalid(format!("--scale {why}")));
     }
     let mut warnings = Vec::new();
-    let (mut cell_m, mut layered) = (None, false);
+    let (mut cell_m, mut layered, mut surface_bodies) = (None, false, None);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, mut report) = modal_tetra::read_surface(path, factor, surface.part.as_deref())?;
             scale.check(report.diagonal_m)?;
+            surface_bodies = Some(report.components.saturating_sub(report.cavities).max(1));
             if surface.sheet_thickness.is_some() {
                 report.drop_open_warning();
             }
@@ -266,5 +270,5 @@ pub(crate) fn load_mesh_sized(
     let (mesh, report) = modal_mesh::check(raw)?;
     warnings.extend(report.warnings.iter().cloned());
     let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
-    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered })
+    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered, surface_bodies })
 }

@@ -201,6 +201,8 @@ pub struct Assembled {
     pub cell_m: Option<f64>,
     /// The surface was meshed in layers across a thin wall.
     pub layered: bool,
+    /// Separate bodies of the input surface (`None` for a tet mesh).
+    pub surface_bodies: Option<usize>,
 }
 
 /// Loads the mesh and assembles K and M (what `export-matrices` writes).
@@ -278,6 +280,7 @@ pub(crate) fn assemble_and_analyze(
         warnings: loaded.warnings,
         cell_m: loaded.cell_m,
         layered: loaded.layered,
+        surface_bodies: loaded.surface_bodies,
     };
     Ok((assembled, analysis))
 }
@@ -373,6 +376,7 @@ pub fn precompute(
             let ((bank, assembled_warnings), level) =
                 crate::levels::within_memory(request, &mut level_warnings, |level| {
                     let (assembled, analysis) = assemble_and_analyze(request, true, level, progress)?;
+                    crate::levels::refuse_broken_fit(&assembled, level)?;
                     let bank = solve_bank(request, &assembled, analysis, key.clone(), progress)?.0;
                     Ok((bank, assembled.warnings))
                 })?;
