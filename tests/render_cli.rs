@@ -358,3 +358,37 @@ fn an_interrupted_json_run_says_so_on_stdout_and_leaves_nothing() {
     assert_eq!(json["error"], "interrupted");
     assert!(!dir.path().join("out").exists(), "the directory made for the WAV is left");
 }
+
+/// A rod dropped flat rings. Rods, tubes and cans collide as exact
+/// cylinders (a part of a compound, turned onto the mesh axis); their
+/// contact points were read in the collider's frame instead of the part's,
+/// so they lay centimetres off the rod (below the floor), every strike was
+/// dropped as too far from the surface and the file was silent.
+#[test]
+fn a_rod_dropped_on_the_floor_rings() {
+    let dir = temp_dir();
+    let scene =
+        "duration = 0.6\nsample_rate = 16000\n[listener]\nposition = [0.0, 0.3, 0.5]\nchannels = \"mono\"\n\
+                 [ground]\nmaterial = \"wood\"\n[[objects]]\nname = \"rod\"\n\
+                 mesh = { generate = \"cylinder\", radius = 0.006, length = 0.12, element_size = 0.006 }\n\
+                 material = \"steel\"\nposition = [0.0, 0.1, 0.0]\nrotation = { euler = [0.0, 90.0, 3.0] }\n";
+    std::fs::write(dir.path().join("rod.toml"), scene).unwrap();
+    let args =
+        ["render", "rod.toml", "-o", "rod.wav", "--radiation", "estimate", "--json", "--events", "e.json"];
+    let report = modal(dir.path(), &args).ok().json();
+    let rod = &report["objects"][0];
+    assert!(rod["strikes"].as_u64().unwrap() > 0, "{report}");
+    assert_eq!(rod["strikes_dropped"].as_u64(), Some(0), "{report}");
+    assert!(report["peak"].as_f64().unwrap() > 1e-3, "{report}");
+    // Every impact is on the floor, not below it.
+    let events: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("e.json")).unwrap()).unwrap();
+    let impacts: Vec<f64> = events
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["kind"] == "impact")
+        .map(|e| e["point_m"][1].as_f64().unwrap())
+        .collect();
+    assert!(!impacts.is_empty() && impacts.iter().all(|y| y.abs() < 2e-3), "impact heights {impacts:?}");
+}

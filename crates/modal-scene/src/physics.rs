@@ -535,12 +535,19 @@ impl World {
             let mut normal = [0.0; 3];
             for m in pair.solver_manifolds() {
                 let n = d3(m.data.normal);
+                // A manifold's points are in its subshape's frame: a compound's
+                // part (the exact ball or cylinder, placed and turned in the
+                // body) has its own. Taken as the collider's, a rod's contacts
+                // lay 5 cm off its surface and every strike was dropped.
+                let in_collider = |sub: Option<&Pose>, p: Vector| sub.map_or(p, |s| s.transform_point(p));
+                let (sub1, sub2) = (m.subshape_pos1(), m.subshape_pos2());
                 for p in &m.points {
                     let jn = p.data.impulse as f64;
                     if jn <= 0.0 || !jn.is_finite() {
                         continue;
                     }
-                    let world_m = d3(c1.position().transform_point(p.local_p1));
+                    let (local1, local2) = (in_collider(sub1, p.local_p1), in_collider(sub2, p.local_p2));
+                    let world_m = d3(c1.position().transform_point(local1));
                     let friction = friction_world(&p.data, n);
                     // The solver pushes body 1 away from body 2, i.e. along −n.
                     let impulse_on_1 =
@@ -551,7 +558,7 @@ impl World {
                     }
                     points.push(ContactPoint {
                         world_m,
-                        local_m: [d3(p.local_p1), d3(p.local_p2)],
+                        local_m: [d3(local1), d3(local2)],
                         impulse_on_1,
                         normal_impulse: jn,
                         separation_m: p.dist as f64,
