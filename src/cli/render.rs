@@ -575,6 +575,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         warn(&clipping_advice(wav.clipped, rendered.report.peak, scene.listener.gain));
     }
     listener_warnings(&scene, &rendered.report).iter().for_each(|w| warn(w));
+    dropped_warnings(&rendered.report).iter().for_each(|w| warn(w));
     let report = &rendered.report;
     if args.json {
         let mut json = serde_json::to_value(report)?;
@@ -646,6 +647,24 @@ const MAX_HEAD_EAR_SPACING_M: f64 = 1.0;
 /// A scene with nothing to sound, a listener set inside a body or under a
 /// solid ground plane, or ears metres apart: what it hears is silence, not
 /// physical or not a head, and nothing else would say so.
+/// One warning per object some of whose strikes could not be synthesized.
+/// None are in a sound scene; a silent rod (its contacts read in the wrong
+/// frame, every strike dropped) said nothing but a count in `--json`.
+fn dropped_warnings(report: &modal_scene::RenderReport) -> Vec<String> {
+    report
+        .objects
+        .iter()
+        .filter(|o| o.strikes_dropped > 0)
+        .map(|o| {
+            format!(
+                "{} of {} impacts on '{}' were not heard: their contact point lay off its mesh's surface, or \
+                 the impulse beyond the output's range (please report it with the scene)",
+                o.strikes_dropped, o.strikes, o.name
+            )
+        })
+        .collect()
+}
+
 fn listener_warnings(scene: &Scene, report: &modal_scene::RenderReport) -> Vec<String> {
     let at = scene.listener.position_m;
     let mut warnings = Vec::new();
@@ -727,7 +746,24 @@ fn output_identity(path: &Path) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
-    use super::clipping_advice;
+    use super::{clipping_advice, dropped_warnings};
+
+    #[test]
+    fn dropped_strikes_are_said_per_object() {
+        let object = |name: &str, strikes, strikes_dropped| modal_scene::ObjectReport {
+            name: name.into(),
+            strikes,
+            strikes_dropped,
+            ..Default::default()
+        };
+        let report = modal_scene::RenderReport {
+            objects: vec![object("bar", 4, 0), object("rod", 3, 3)],
+            ..Default::default()
+        };
+        let said = dropped_warnings(&report);
+        assert_eq!(said.len(), 1, "{said:?}");
+        assert!(said[0].starts_with("3 of 3 impacts on 'rod' were not heard"), "{}", said[0]);
+    }
 
     #[test]
     fn the_clipping_advice_names_a_gain_that_fits_the_peak() {
