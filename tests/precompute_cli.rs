@@ -105,6 +105,15 @@ fn outputs_go_into_new_directories_made_before_the_work() {
     let missing = ["precompute", "none.obj", "-o", "nothing/x.bank", "--material", "steel"];
     modal(dir.path(), &missing).fails_with("none.obj");
     assert!(!dir.path().join("nothing").exists(), "a refused input made its output directory");
+    // A pipe (or /dev/null) is no output: the rename would have replaced it with a file.
+    assert!(std::process::Command::new("mkfifo").arg(dir.path().join("pipe")).status().unwrap().success());
+    let to_pipe = ["mesh", "box", "--size", "0.2,0.02,0.01", "--h", "0.01", "-o", "pipe"];
+    modal(dir.path(), &to_pipe).fails_with("is not a regular file");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::metadata(dir.path().join("pipe")).unwrap().file_type().is_fifo(),
+        "the pipe was replaced"
+    );
 }
 
 #[test]

@@ -54,7 +54,7 @@ pub fn run(command: CatalogueCommand) -> Result<()> {
 
 fn merge(args: MergeArgs) -> Result<()> {
     let out_dir = super::directory_of(&args.out);
-    std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
+    super::prepare_output(&args.out).with_context(|| format!("cannot write -o {}", args.out.display()))?;
     let (merged, report) = modal_batch::merge(&args.inputs, out_dir)?;
     if !merged.complete && !args.partial {
         let mut why: Vec<String> = report.missing.iter().take(MISSING_LISTED).cloned().collect();

@@ -32,6 +32,16 @@ pub fn remove_made_directories() {
 pub fn prepare_output(path: &Path) -> anyhow::Result<()> {
     let dir = directory_of(path);
     anyhow::ensure!(!path.is_dir(), "{} is a directory", path.display());
+    // An output replaces its path by a rename: `-o /dev/null` as root would
+    // replace the device with a file (a FIFO was). Only files are outputs.
+    if let Ok(meta) = std::fs::metadata(path) {
+        anyhow::ensure!(
+            meta.is_file(),
+            "{} is not a regular file (a device or a pipe): outputs are written to a temporary file and renamed \
+             over their path, which would replace it; give a file path",
+            path.display()
+        );
+    }
     let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{} is not a file name", path.display()))?;
     if !dir.is_dir() {
         let missing: Vec<PathBuf> = dir
