@@ -200,13 +200,17 @@ pub(crate) enum Data {
 }
 
 impl Data {
-    /// Memory held [bytes].
-    fn bytes(&self) -> usize {
-        let entries = match self {
+    /// Complex entries stored.
+    fn entries(&self) -> usize {
+        match self {
             Data::Dense(d) => d.len(),
             Data::LowRank { u, w } => u.iter().chain(w).map(Vec::len).sum(),
-        };
-        entries * std::mem::size_of::<c64>()
+        }
+    }
+
+    /// Memory held [bytes].
+    fn bytes(&self) -> usize {
+        self.entries() * std::mem::size_of::<c64>()
     }
 }
 
@@ -342,15 +346,12 @@ impl HMatrix {
     pub fn stats(&self) -> HStats {
         let mut s = HStats::default();
         for b in &self.blocks {
+            s.stored += b.data.entries();
             match &b.data {
-                Data::Dense(d) => {
-                    s.dense_blocks += 1;
-                    s.stored += d.len();
-                }
-                Data::LowRank { u, w } => {
+                Data::Dense(_) => s.dense_blocks += 1,
+                Data::LowRank { u, .. } => {
                     s.low_rank_blocks += 1;
                     s.max_rank = s.max_rank.max(u.len());
-                    s.stored += u.iter().chain(w).map(Vec::len).sum::<usize>();
                 }
             }
         }
