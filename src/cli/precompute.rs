@@ -72,6 +72,14 @@ pub fn memory_guard_bytes() -> Result<Option<u64>> {
     Ok(memory_limit_from_env()?.or_else(modal_eigen::default_memory_limit))
 }
 
+/// Refuses an input mesh that cannot be opened, as the solve would say it,
+/// before the output's directory is made for a command that then fails.
+fn openable(command: &str, mesh: &Path) -> Result<()> {
+    std::fs::File::open(mesh)
+        .map_err(|e| anyhow::anyhow!("{command} {0}: cannot read {0}: {e}", mesh.display()))?;
+    Ok(())
+}
+
 /// The cache the flags ask for (none with `--no-cache`). A path that exists
 /// and is not a directory is refused at once: every asset of a batch would
 /// otherwise report it as "a damaged cache entry".
@@ -117,10 +125,7 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
         );
     }
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
-    // An input that cannot be opened is said (as the solve would say it) before
-    // the output's directory is made.
-    std::fs::File::open(&args.mesh)
-        .map_err(|e| anyhow::anyhow!("precompute {0}: cannot read {0}: {e}", args.mesh.display()))?;
+    openable("precompute", &args.mesh)?;
     super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let spinner = Spinner::new("starting");
     // Warnings about the input are said when the mesh is read, once each, not after the solve.
@@ -171,8 +176,7 @@ fn transfer(bank: &modal_bank::ModeBank, max_hz: f64) -> Result<Option<modal_ban
 
 pub fn export_matrices(args: ExportMatricesArgs) -> Result<()> {
     let request = request(&args.mesh, &args.material, &args.input)?;
-    std::fs::File::open(&args.mesh)
-        .map_err(|e| anyhow::anyhow!("export-matrices {0}: cannot read {0}: {e}", args.mesh.display()))?;
+    openable("export-matrices", &args.mesh)?;
     // Made and probed before the assembly, which can take minutes.
     let [k_path, m_path, nodes_path] = ["K.mtx", "M.mtx", "nodes.csv"].map(|name| args.out.join(name));
     for path in [&k_path, &m_path, &nodes_path] {
