@@ -324,14 +324,15 @@ impl Manifest {
         // A bank named like a directory another bank needs (`props` beside
         // `props/cup.bank`): one of the two could not be written.
         for bank in by_bank.keys() {
-            if let Some(inside) = by_bank.range(format!("{bank}/")..).next().map(|(b, _)| b) {
-                if inside.starts_with(&format!("{bank}/")) {
-                    return Err(self.error(format!(
-                        "{} writes bank '{bank}', a file where {} needs a directory for '{inside}': give one \
-                         of them another `bank = \"…\"`",
-                        origin[bank], origin[inside]
-                    )));
-                }
+            let dir = format!("{bank}/");
+            if let Some((inside, _)) =
+                by_bank.range(dir.clone()..).next().filter(|(b, _)| b.starts_with(&dir))
+            {
+                return Err(self.error(format!(
+                    "{} writes bank '{bank}', a file where {} needs a directory for '{inside}': give one \
+                     of them another `bank = \"…\"`",
+                    origin[bank], origin[inside]
+                )));
             }
         }
         Ok((by_bank.into_values().collect(), warnings))
