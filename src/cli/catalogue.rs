@@ -43,7 +43,15 @@ struct MergeJson {
     failed: usize,
     pending: usize,
     missing_shards: Vec<String>,
+    /// Assets of the library that no input lists (a lost shard catalogue).
+    missing_assets: usize,
     complete: bool,
+}
+
+/// "N of the library's M assets are in no catalogue".
+fn missing_assets(report: &modal_batch::MergeReport, merged: &modal_batch::Catalogue) -> String {
+    let total = merged.library.as_ref().map_or(0, |lib| lib.assets);
+    format!("{} of the library's {total} assets are in no catalogue", report.missing_assets)
 }
 
 pub fn run(command: CatalogueCommand) -> Result<()> {
@@ -61,6 +69,9 @@ fn merge(args: MergeArgs) -> Result<()> {
         if report.missing.len() > MISSING_LISTED {
             why.push(format!("and {} more missing shards", report.missing.len() - MISSING_LISTED));
         }
+        if report.missing_assets > 0 {
+            why.push(missing_assets(&report, &merged));
+        }
         if !merged.pending.is_empty() {
             why.push(format!("{} assets unfinished (e.g. {})", merged.pending.len(), merged.pending[0]));
         }
@@ -76,6 +87,9 @@ fn merge(args: MergeArgs) -> Result<()> {
     if report.missing.len() > MISSING_LISTED {
         warn(&format!("and {} more missing shards", report.missing.len() - MISSING_LISTED));
     }
+    if report.missing_assets > 0 {
+        warn(&missing_assets(&report, &merged));
+    }
     merged.save(&args.out)?;
     let summary = MergeJson {
         catalogue: args.out.display().to_string(),
@@ -84,6 +98,7 @@ fn merge(args: MergeArgs) -> Result<()> {
         failed: merged.failed(),
         pending: merged.pending.len(),
         missing_shards: report.missing,
+        missing_assets: report.missing_assets,
         complete: merged.complete,
     };
     if args.json {

@@ -14,6 +14,9 @@ pub struct MergeReport {
     pub inputs: Vec<PathBuf>,
     /// Shards no input catalogue is from (`"shard I of N"`).
     pub missing: Vec<String>,
+    /// Assets of the library (as the catalogues record it) that no input
+    /// lists, finished or pending: a shard's catalogue lost or cut short.
+    pub missing_assets: usize,
 }
 
 /// Joins catalogues into one whose banks are relative to `out_dir`.
@@ -78,11 +81,10 @@ pub fn merge(inputs: &[PathBuf], out_dir: &Path) -> Result<(Catalogue, MergeRepo
                 ),
             });
         }
-        if listed < lib.assets {
-            report.missing.push(format!("{} of the library's {} assets", lib.assets - listed, lib.assets));
-        }
+        report.missing_assets = lib.assets - listed;
     }
-    merged.complete = complete && merged.pending.is_empty() && report.missing.is_empty();
+    merged.complete =
+        complete && merged.pending.is_empty() && report.missing.is_empty() && report.missing_assets == 0;
     Ok((merged, report))
 }
 
@@ -340,7 +342,8 @@ mod tests {
         let lost = save("d.json", b, &["c.obj"], library("f", 4));
         let (merged, report) = merge(&[first.clone(), lost], dir.path()).unwrap();
         assert!(!merged.complete);
-        assert_eq!(report.missing, ["1 of the library's 4 assets"]);
+        assert!(report.missing.is_empty());
+        assert_eq!(report.missing_assets, 1);
         // A catalogue from before libraries were recorded: merged, not checked.
         let old = save("e.json", b, &["c.obj"], None);
         let (merged, _) = merge(&[first, old], dir.path()).unwrap();
