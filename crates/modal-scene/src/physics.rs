@@ -753,6 +753,12 @@ fn add_object(
     activation.normalized_linear_threshold =
         (0.5 * SLEEP_SPEED_M_S) as f32 / world.integration_parameters.length_unit;
     world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
+    // rapier derives the world centre of mass and the extent from the mass
+    // properties at the first step; before it, `center_of_mass()` is the mesh
+    // origin (a generated box's corner), and the first step's approach speeds
+    // would be taken about it (a box set tipping on its edge "struck" the
+    // floor at 0.05–0.07 m/s at t = 0).
+    world.bodies[handle].recompute_mass_properties_from_colliders(&world.colliders);
     let side = ContactSide {
         object: Some(i),
         plane_strain_pa: plane_strain_modulus(material),

@@ -249,3 +249,23 @@ fn a_pushed_domino_topples_the_chain_at_the_default_rolling_resistance() {
     let stopped = impacts("rolling_resistance = 0.003");
     assert!(stopped.is_empty(), "{stopped:?}");
 }
+
+#[test]
+fn a_body_set_tipping_on_its_edge_strikes_nothing_at_the_start() {
+    // A 5 × 20 × 5 cm box turning about its bottom edge at 1.9 rad/s (its
+    // centre of mass at ω × (c − edge)): the edge rests, so the first step
+    // has no impact. Taken about the mesh origin (the box's corner) instead
+    // of the centre of mass, the edge closed at 0.025·ω + g·dt/2 = 0.052 m/s.
+    let object = r#"name = "box"
+mesh = { generate = "box", size = [0.05, 0.2, 0.05] }
+material = "wood"
+position = [0.0, 0.1, 0.0]
+linear_velocity = [0.19, 0.0475, 0.0]
+angular_velocity = [0.0, 0.0, -1.9]"#;
+    let scene = one_on_the_floor(0.3, "", object);
+    let mut p = InMemoryProvider::new();
+    p.insert("box", common::block([0.05, 0.2, 0.05], &[1800.0]));
+    let out = render(&scene, &mut p, &RenderOptions { collect_events: true }).expect("render");
+    let early: Vec<_> = out.events.iter().filter(|e| e.time_s < 0.05).collect();
+    assert!(early.is_empty(), "{early:?}");
+}
