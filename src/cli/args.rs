@@ -349,8 +349,8 @@ pub struct StrikeArgs {
     /// Mode bank.
     pub bank: PathBuf,
     /// Struck point X,Y,Z [m] (snapped to the nearest surface point); repeat for several strikes.
-    /// Default: one strike at the surface point farthest from the centre of mass (a rim, a tip, a
-    /// corner: where most modes move), printed on stderr.
+    /// Default: one strike along the normal where the lowest modes move most along it (a bar
+    /// across its broad face near an end, a bowl radially at the rim), printed on stderr.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub at: Vec<[f64; 3]>,
     /// Impulse direction X,Y,Z (default: into the surface); one, or one per --at.

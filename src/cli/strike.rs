@@ -144,7 +144,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     let (bank, stored) = load_bank_with_radiation(&args.bank)?;
     let model = SynthModel::new(&bank).context("cannot synthesize this bank")?;
     let at_points = if args.at.is_empty() {
-        vec![farthest_surface_point(&bank).context("the bank has no surface to strike")?]
+        vec![model.ringing_point().context("the bank has no surface to strike")?]
     } else {
         args.at.clone()
     };
@@ -177,7 +177,7 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     if let ([at], true) = (at_points.as_slice(), args.at.is_empty()) {
         // Said once the strike is known to be valid, before the slow part.
         eprintln!(
-            "strike: no --at, so struck at ({:.4}, {:.4}, {:.4}) m, the surface point farthest from the centre of mass",
+            "strike: no --at, so struck at ({:.4}, {:.4}, {:.4}) m, along the normal, where the lowest modes move most",
             at[0], at[1], at[2]
         );
     }
@@ -306,19 +306,6 @@ pub fn run(args: StrikeArgs) -> Result<()> {
     }
     print_human(&json);
     Ok(())
-}
-
-/// The surface node farthest from the centre of mass (the first of equals):
-/// the default struck point, where a rim, a tip or a corner moves in most
-/// modes. `None` for a bank without surface nodes.
-fn farthest_surface_point(bank: &ModeBank) -> Option<[f64; 3]> {
-    let c = bank.mass.center_of_mass_m;
-    let distance = |p: &[f64; 3]| (0..3).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>();
-    bank.surface
-        .positions
-        .iter()
-        .copied()
-        .reduce(|best, p| if distance(&p) > distance(&best) { p } else { best })
 }
 
 /// The loudest modes the first strike excites.

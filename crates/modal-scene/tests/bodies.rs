@@ -211,7 +211,8 @@ rolling_resistance = 0.0"#;
 fn domino_chain(rolling_resistance: &str) -> Scene {
     let spin = 4.0;
     let (half_height, half_thickness) = (0.024, 0.00375);
-    let mut text = String::from("duration = 1.0\nsample_rate = 16000\n[listener]\nchannels = \"mono\"\n[ground]\n");
+    let mut text =
+        String::from("duration = 1.0\nsample_rate = 16000\n[listener]\nchannels = \"mono\"\n[ground]\n");
     for i in 0..3 {
         text += &format!(
             "[[objects]]\nname = \"d{i}\"\nmesh = {{ generate = \"box\", size = [0.024, 0.048, 0.0075] }}\n\

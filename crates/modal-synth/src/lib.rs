@@ -45,7 +45,7 @@ pub use contact::{
 pub use degenerate::degenerate_phases;
 pub use error::SynthError;
 pub use force::{DrivenStats, DrivenVoice, ForceSegment};
-pub use model::{SynthModel, MAX_SNAP_FRACTION};
+pub use model::{SynthModel, MAX_SNAP_FRACTION, RINGING_MODES};
 pub use modulation::OutputModulation;
 pub use offline::{
     auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,

@@ -149,7 +149,68 @@ impl SynthModel {
         }
         acc
     }
+
+    /// Where a tap along the surface normal rings the lowest modes most: the
+    /// centroid of the corner triangle `T` maximizing
+    /// `Σ_{i < K} (v_i(T) / max_T' |v_i(T')|)²`, `v_i(T)` the mean normal
+    /// shape `φ_i·n_T` over `T`'s corners and `K` = [`RINGING_MODES`] (each
+    /// mode weighs the same, whatever its normalization). A bar is struck on
+    /// its broad face at an end, a bowl or a bell radially at the rim, a
+    /// plate across its face at the edge: where a player strikes them, and
+    /// where the body's farthest point (a corner, whose tap points along the
+    /// bar's axis) is not. Only faces turned away from the centre of mass
+    /// are candidates (struck from outside). `None` without modes or a
+    /// non-degenerate triangle.
+    pub fn ringing_point(&self) -> Option<[f64; 3]> {
+        let s = self.surface();
+        let nodes = s.positions.len();
+        let faces = TriangleNormals::new(s);
+        let modes = self.mode_count().min(RINGING_MODES);
+        if modes == 0 || faces.triangles.is_empty() {
+            return None;
+        }
+        // v[i][t]: mode i's mean normal shape over triangle t.
+        let v: Vec<Vec<f64>> = (0..modes)
+            .map(|i| {
+                let mode = &self.bank.shapes[i * nodes * 3..(i + 1) * nodes * 3];
+                let normal_shape = |k: usize, n: &[f64; 3]| {
+                    let sh = &mode[k * 3..k * 3 + 3];
+                    sh[0] as f64 * n[0] + sh[1] as f64 * n[1] + sh[2] as f64 * n[2]
+                };
+                faces
+                    .triangles
+                    .iter()
+                    .zip(&faces.area_normal)
+                    .map(|(tri, (_, n))| tri.iter().map(|&k| normal_shape(k, n)).sum::<f64>() / 3.0)
+                    .collect()
+            })
+            .collect();
+        let largest: Vec<f64> = v.iter().map(|vi| vi.iter().fold(0.0, |m: f64, x| m.max(x.abs()))).collect();
+        let score = |t: usize| -> f64 {
+            (0..modes).filter(|&i| largest[i] > 0.0).map(|i| (v[i][t] / largest[i]).powi(2)).sum()
+        };
+        let centroid = |t: usize| {
+            let corners = faces.triangles[t].map(|k| s.positions[k]);
+            [0, 1, 2].map(|c| (corners[0][c] + corners[1][c] + corners[2][c]) / 3.0)
+        };
+        // Struck from outside: a face turned away from the centre of mass (a
+        // tube's or a cup's inside rings as its outside does, but is not
+        // where a tap comes from). A closed surface always has such faces.
+        let com = self.bank.mass.center_of_mass_m;
+        let outer = |t: usize| {
+            let (c, n) = (centroid(t), faces.area_normal[t].1);
+            (0..3).map(|k| (c[k] - com[k]) * n[k]).sum::<f64>() > 0.0
+        };
+        let scores: Vec<f64> =
+            (0..faces.triangles.len()).map(|t| if outer(t) { score(t) } else { f64::NEG_INFINITY }).collect();
+        // The first of equals: the same point on every run.
+        let best = (0..scores.len()).fold(0, |best, t| if scores[t] > scores[best] { t } else { best });
+        Some(centroid(best))
+    }
 }
+
+/// How many of the lowest modes [`SynthModel::ringing_point`] rings.
+pub const RINGING_MODES: usize = 4;
 
 /// The non-degenerate corner triangles of a surface with their areas and
 /// outward unit normals, and the total area \[m²\].
@@ -254,6 +315,45 @@ mod tests {
         assert!((g[0] - (1.0f64 / 3.0).sqrt()).abs() < 1e-15, "{}", g[0]);
         assert!((g[1] - 0.5).abs() < 1e-15, "{}", g[1]);
         assert_eq!(g[2], 0.0);
+    }
+
+    #[test]
+    fn the_ringing_point_is_where_the_normal_motion_is_largest_and_outside() {
+        // A unit box with a cavity (a box of half its size at its centre, faces
+        // turned inwards). Mode 0 moves every node away from the centre, four
+        // times as far on the cavity's walls: their normal motion is twice the
+        // outer walls', but they face the centre of mass and are not struck.
+        let mut bank = SyntheticBank::preset("steel", 3).build();
+        let mut surface = crate::synthetic::box_surface([1.0, 1.0, 1.0]);
+        let cavity = crate::synthetic::box_surface([0.5, 0.5, 0.5]);
+        let outer_nodes = surface.positions.len();
+        surface.positions.extend(cavity.positions.iter().map(|p| p.map(|c| c + 0.25)));
+        surface
+            .triangles
+            .extend(cavity.triangles.iter().map(|&[a, b, c]| [a, c, b].map(|k| k + outer_nodes)));
+        bank.mass.center_of_mass_m = [0.5; 3];
+        let away =
+            |k: usize, p: &[f64; 3]| p.map(|c| ((c - 0.5) * if k < outer_nodes { 1.0 } else { 4.0 }) as f32);
+        let nodes = surface.positions.len();
+        bank.shapes = surface
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(k, p)| away(k, p))
+            .chain((0..2 * nodes).map(|_| [0.0f32; 3]))
+            .flatten()
+            .collect();
+        bank.surface = surface;
+        let model = SynthModel::new(&bank).expect("model");
+        let p = model.ringing_point().expect("a point");
+        let on_outer_wall = p.iter().any(|&c| c == 0.0 || c == 1.0);
+        assert!(on_outer_wall, "{p:?} is not on the outer wall");
+        // Without modes there is nothing to ring.
+        bank.frequencies_hz.clear();
+        bank.decay_rates.clear();
+        bank.damping_ratios.clear();
+        bank.shapes.clear();
+        assert_eq!(SynthModel::new(&bank).expect("model").ringing_point(), None);
     }
 
     #[test]
