@@ -55,6 +55,10 @@ fn strike_writes_a_wav_that_is_linear_in_the_impulse() {
     let (a, b) = (wav_samples(&dir.path().join("one.wav")), wav_samples(&dir.path().join("two.wav")));
     assert_eq!(a.len(), 22050);
     assert!(a.iter().any(|&s| s.abs() > 100), "audible");
+    // The bar still rings at 0.5 s; the fixed length ends with a 5 ms fade, not a click.
+    let before_fade = &a[a.len() - 441..a.len() - 221];
+    assert!(before_fade.iter().any(|&s| s.abs() > 10), "still ringing before the fade");
+    assert_eq!(a[a.len() - 1], 0, "faded out");
     // 16-bit quantization allows ±1 LSB after doubling.
     assert!(
         a.iter().zip(&b).all(|(&x, &y)| (2 * x as i32 - y as i32).abs() <= 2),
@@ -105,6 +109,10 @@ fn bad_strikes_fail_cleanly_without_output() {
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "-1", "-o", "x.wav"], "duration"),
         (vec!["strike", "bar.bank", at[0], at[1], "--time", "1", "--time", "2", "-o", "x.wav"], "--time"),
         (vec!["strike", "bar.bank", at[0], at[1], "--duration", "0", "-o", "x.wav"], "above 0 s"),
+        (
+            vec!["strike", "bar.bank", at[0], at[1], "--duration", "1e-5", "-o", "x.wav"],
+            "shorter than one sample",
+        ),
         (
             vec!["strike", "bar.bank", at[0], at[1], "--contact-time", "-1", "-o", "x.wav"],
             "contact time -1 s",

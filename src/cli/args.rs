@@ -382,8 +382,8 @@ pub struct StrikeArgs {
     /// Solve the radiation now when the bank has none stored (slow; see `modal radiation --store`).
     #[arg(long, conflicts_with = "mic")]
     pub solve_radiation: bool,
-    /// Duration [s], above 0 and at most 3600 (default: until the sound decayed by 60 dB, at most 30 s
-    /// after the last strike).
+    /// Duration [s], at least one sample and at most 3600; it ends with a 5 ms fade (default: until
+    /// the sound decayed by 60 dB, at most 30 s after the last strike).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Sample rate [Hz].

@@ -131,6 +131,12 @@ pub fn run(args: StrikeArgs) -> Result<()> {
             "--duration must be above 0 s and at most {} s (got {d})",
             modal_synth::MAX_DURATION_S
         );
+        // (A shorter one wrote an empty WAV blamed on the strike.)
+        ensure!(
+            (d * args.rate as f64).round() >= 1.0,
+            "--duration {d} s is shorter than one sample at --rate {} Hz",
+            args.rate
+        );
     }
     super::prepare_output(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     super::check_not_input(&args.out, &args.bank, "-o")?;
@@ -230,7 +236,11 @@ pub fn run(args: StrikeArgs) -> Result<()> {
         Some(d) => RenderLength::Fixed(d),
         None => RenderLength::Auto { cap_s: (last_s + AUTO_DURATION_CAP_S).min(modal_synth::MAX_DURATION_S) },
     };
-    let rendered = render_strikes(&bank, &strikes, &options, length)?;
+    let mut rendered = render_strikes(&bank, &strikes, &options, length)?;
+    if args.duration.is_some() {
+        // A cut through a ringing body clicks; end it as `render` does.
+        modal_synth::fade_out(&mut rendered.samples, (modal_scene::FADE_OUT_S * args.rate as f64) as usize);
+    }
     let top_modes = top_modes(&bank, &strikes[0], &options)?;
     let format = if args.float { WavFormat::Float32 } else { WavFormat::Pcm16 };
     let gain = if args.normalize { WavGain::Normalize { peak: NORMALIZED_PEAK } } else { WavGain::default() };

@@ -48,8 +48,8 @@ pub use force::{DrivenStats, DrivenVoice, ForceSegment};
 pub use model::{SynthModel, MAX_SNAP_FRACTION, RINGING_MODES};
 pub use modulation::OutputModulation;
 pub use offline::{
-    auto_duration, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S, MAX_DURATION_S,
-    MIN_AUTO_DURATION_S,
+    auto_duration, fade_out, render_strikes, RenderLength, Rendered, Strike, AUTO_DECAY_DB, FADE_S,
+    MAX_DURATION_S, MIN_AUTO_DURATION_S,
 };
 pub use options::{
     check_sample_rate, classify_mode, Kernel, OutputGain, OutputQuantity, SkipReason, SynthOptions,

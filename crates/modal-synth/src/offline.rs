@@ -150,8 +150,8 @@ pub fn auto_duration(voice: &mut ModalVoice, cap_s: f64) -> (f64, bool) {
     (hi.max(floor), false)
 }
 
-/// Raised-cosine fade over the last `n` samples.
-fn fade_out(samples: &mut [f32], n: usize) {
+/// Raised-cosine fade over the last `n` samples (all of them if fewer).
+pub fn fade_out(samples: &mut [f32], n: usize) {
     let n = n.min(samples.len());
     let start = samples.len() - n;
     for (k, x) in samples[start..].iter_mut().enumerate() {
