@@ -69,6 +69,10 @@ pub struct LoadedMesh {
     /// Separate bodies of the input surface (its components, a hollow body's
     /// inner wall not counted); `None` for a tet mesh.
     pub surface_bodies: Option<usize>,
+    /// The tet mesh's volume over the volume its surface encloses (a part
+    /// thinner than the cells is lost); `None` for a tet mesh or a surface
+    /// enclosing no volume (a sheet).
+    pub volume_kept: Option<f64>,
 }
 
 /// How a discretization level (`crate::levels`) sizes a surface mesh's tets.
@@ -204,7 +208,7 @@ pub(crate) fn load_mesh_sized(
         return Err(PrecomputeError::Invalid(format!("--scale {why}")));
     }
     let mut warnings = Vec::new();
-    let (mut cell_m, mut layered, mut surface_bodies) = (None, false, None);
+    let (mut cell_m, mut layered, mut surface_bodies, mut surface_volume_m3) = (None, false, None, None);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, mut report) = modal_tetra::read_surface(path, factor, surface.part.as_deref())?;
@@ -235,6 +239,7 @@ pub(crate) fn load_mesh_sized(
             warnings.extend(tet_report.warnings);
             cell_m = Some(tet_report.cell_m);
             layered = tet_report.wall_layers > 0;
+            surface_volume_m3 = Some(tet_report.surface_volume_m3).filter(|v| *v > 0.0);
             mesh
         }
         MeshSource::File(path) => {
@@ -270,5 +275,7 @@ pub(crate) fn load_mesh_sized(
     let (mesh, report) = modal_mesh::check(raw)?;
     warnings.extend(report.warnings.iter().cloned());
     let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
-    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered, surface_bodies })
+    // (The mesher warns when it is small.)
+    let volume_kept = surface_volume_m3.map(|v| modal_mesh::mesh_volume(&mesh) / v);
+    Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered, surface_bodies, volume_kept })
 }

@@ -203,6 +203,8 @@ pub struct Assembled {
     pub layered: bool,
     /// Separate bodies of the input surface (`None` for a tet mesh).
     pub surface_bodies: Option<usize>,
+    /// The mesh's volume over the surface's (`LoadedMesh::volume_kept`).
+    pub volume_kept: Option<f64>,
 }
 
 /// Loads the mesh and assembles K and M (what `export-matrices` writes).
@@ -281,6 +283,7 @@ pub(crate) fn assemble_and_analyze(
         cell_m: loaded.cell_m,
         layered: loaded.layered,
         surface_bodies: loaded.surface_bodies,
+        volume_kept: loaded.volume_kept,
     };
     Ok((assembled, analysis))
 }

@@ -101,7 +101,7 @@ pub use graded::MAX_LEVELS;
 pub use mesher::{
     tetrahedralize, TetOptions, TetReport, DEFAULT_CELLS_PER_DIAGONAL, DEFAULT_CELLS_PER_THICKNESS,
     DEFAULT_MAX_TETS, GAP_WARNING, HINGED_DROP_FRACTION, LAYERED_CELL_PER_WALL, LAYERED_MIN_CELLS_PER_WALL,
-    LAYERED_STRAIGHT_CELL_PER_WALL,
+    LAYERED_STRAIGHT_CELL_PER_WALL, VOLUME_KEPT_WARNING,
 };
 pub use read::{gltf_buffers, gltf_uri_buffers, parse_surface, read_surface, SurfaceFormat};
 pub use sizing::{CONE_DEG, GRADING};

@@ -149,6 +149,11 @@ impl TetOptions {
     }
 }
 
+/// Below this fraction of the volume the surface encloses kept by the tet
+/// mesh, a warning says how much of the object is missing (ordinary assets
+/// keep 97–100 %).
+pub const VOLUME_KEPT_WARNING: f64 = 0.9;
+
 /// What the tetrahedralizer produced.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TetReport {
@@ -412,6 +417,15 @@ pub fn tetrahedralize(
         max_surface_deviation_m = max_surface_deviation_m.max(r.max_surface_deviation_m);
         min_dihedral_deg = min_dihedral_deg.min(r.min_dihedral_deg);
         max_dihedral_deg = max_dihedral_deg.max(r.max_dihedral_deg);
+    }
+    let enclosed_m3 = repaired.report.enclosed_volume_m3;
+    if enclosed_m3 > 0.0 && volume_m3 < VOLUME_KEPT_WARNING * enclosed_m3 {
+        // The gap warning gives the place; this, how much of the body (and its mass) is gone.
+        warnings.push(format!(
+            "the tet mesh holds {:.0} % of the volume the surface encloses: parts thinner than the cells are \
+             missing, and with them mass and modes (a smaller --cell keeps them)",
+            100.0 * volume_m3 / enclosed_m3
+        ));
     }
     let report = TetReport {
         tets: mesh.cells.len(),

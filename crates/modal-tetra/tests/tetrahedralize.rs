@@ -517,3 +517,25 @@ fn issue_14_a_thin_solid_falls_back_to_a_finer_cell_or_names_one() {
     assert_good(&m, &r);
     assert!(rel(r.volume_m3, r.surface_volume_m3).abs() < 0.01, "{r:?}");
 }
+
+/// A 2 cm block through a 10 cm plate 1 mm thick: at a 1 cm cell the plate is
+/// lost, and with it over half the volume (and mass) the surface encloses.
+/// Said in so many words, beside the gap's place; at the defaults it is kept.
+#[test]
+fn robust_a_mesh_that_loses_most_of_the_volume_says_how_much() {
+    let mut plate = shapes::cuboid(0.1, 0.001, 0.1);
+    translate(&mut plate, [-0.04, 0.0095, -0.04]);
+    let s = union(&shapes::cuboid(0.02, 0.02, 0.02), &plate);
+    let lost =
+        |r: &TetReport| r.warnings.iter().find(|w| w.contains("of the volume the surface encloses")).cloned();
+    let options = TetOptions { cell: Some(0.01), ..TetOptions::default() };
+    let (m, r) = tetrahedralize(&s, &options).unwrap();
+    assert_good(&m, &r);
+    assert!(r.volume_m3 < 0.5 * r.surface_volume_m3, "{r:?}");
+    let said = lost(&r).expect("a warning");
+    let pct = 100.0 * r.volume_m3 / r.surface_volume_m3;
+    assert!(said.starts_with(&format!("the tet mesh holds {pct:.0} %")), "{said}");
+    let r = mesh(&s);
+    assert!(r.volume_m3 > modal_tetra::VOLUME_KEPT_WARNING * r.surface_volume_m3, "{r:?}");
+    assert_eq!(lost(&r), None, "{:?}", r.warnings);
+}
