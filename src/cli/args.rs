@@ -268,7 +268,7 @@ pub struct PrecomputeArgs {
     #[arg(long, value_name = "PCT|off", default_value = "1", value_parser = parse_accuracy, allow_negative_numbers = true)]
     pub accuracy: Accuracy,
     /// The --accuracy target applies to the lowest N modes (all modes get an estimate).
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    #[arg(long, value_name = "N", default_value_t = modal_precompute::DEFAULT_ACCURACY_MODES)]
     pub accuracy_modes: usize,
     /// Also solve each audible mode's acoustic transfer up to HZ and store it in the bank
     /// (format 2), as `modal radiation BANK --max-freq HZ --store` does (default air).
@@ -282,6 +282,13 @@ pub struct PrecomputeArgs {
 /// `--accuracy`: a target in percent, or off.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Accuracy(pub Option<f64>);
+
+impl Default for Accuracy {
+    /// 1 %, as the flags' `default_value` (`render` without a command is built from this).
+    fn default() -> Self {
+        Accuracy(Some(1.0))
+    }
+}
 
 fn parse_accuracy(s: &str) -> Result<Accuracy, String> {
     if s.eq_ignore_ascii_case("off") {
@@ -447,6 +454,11 @@ pub struct RenderArgs {
     /// Accepted for old scripts: solving the transfer is now the default.
     #[arg(long, hide = true)]
     pub solve_radiation: bool,
+    /// Objects given as surface meshes (OBJ, STL, PLY, OFF, glTF) are solved to this accuracy
+    /// of their lowest 10 modes, as `modal precompute --accuracy` (so both give one object the
+    /// same modes); `off`: one solve at the default cells, no estimate (faster, coarser).
+    #[arg(long, value_name = "PCT|off", default_value = "1", value_parser = parse_accuracy, allow_negative_numbers = true)]
+    pub accuracy: Accuracy,
 }
 
 /// `render --radiation`.

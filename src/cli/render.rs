@@ -55,6 +55,8 @@ struct PipelineProvider<'a> {
     /// Bank files retuned to their object's material or scale, each with its
     /// stored transfer as it carries over (`None`: it does not, or none).
     retuned: Vec<(BankRequest, Option<RadiationTable>)>,
+    /// `--accuracy` of surface-mesh objects (`None`: one solve, no estimate).
+    accuracy: Option<modal_precompute::AccuracyTarget>,
 }
 
 /// Refuses a generated shape whose quadratic mesh could not fit the memory
@@ -391,6 +393,11 @@ impl PipelineProvider<'_> {
         pipeline.max_modes = request.max_modes.unwrap_or(modal_scene::DEFAULT_SCENE_MODES);
         pipeline.threads = self.threads;
         pipeline.memory_limit_bytes = self.memory_limit_bytes;
+        // As `precompute` solves a surface mesh (a tet mesh or a generated
+        // shape is solved as given, and would only be told so).
+        if modal_precompute::remeshable(&pipeline.source) {
+            pipeline.accuracy = self.accuracy.clone();
+        }
         pipeline
     }
 
@@ -529,6 +536,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         transfer_max_hz: args.transfer_max_freq.unwrap_or(DEFAULT_TRANSFER_MAX_HZ),
         memory_limit_bytes: memory_limit_from_env()?,
         retuned: Vec::new(),
+        accuracy: args.accuracy.0.map(|target_pct| modal_precompute::AccuracyTarget {
+            target_pct,
+            modes: modal_precompute::DEFAULT_ACCURACY_MODES,
+        }),
     };
     let options = modal_scene::RenderOptions { collect_events: args.events.is_some() };
     let mut rendered = modal_scene::render(&scene, &mut provider, &options);

@@ -82,10 +82,13 @@ pub struct AccuracyTarget {
     pub modes: usize,
 }
 
+/// How many of the lowest modes the default accuracy target applies to.
+pub const DEFAULT_ACCURACY_MODES: usize = 10;
+
 impl Default for AccuracyTarget {
-    /// 1 % on the lowest 10 modes (the CLI default).
+    /// 1 % on the lowest [`DEFAULT_ACCURACY_MODES`] modes (the CLI default).
     fn default() -> Self {
-        AccuracyTarget { target_pct: 1.0, modes: 10 }
+        AccuracyTarget { target_pct: 1.0, modes: DEFAULT_ACCURACY_MODES }
     }
 }
 

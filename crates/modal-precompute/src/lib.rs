@@ -20,8 +20,8 @@ mod pipeline;
 
 pub use key::cache_key;
 pub use levels::{
-    remeshable, AccuracyTarget, BAND_MARGIN, COARSE_FACTOR, LEVELS_VERSION, MAX_REFINEMENTS, MAX_STEP,
-    MIN_STEP, PRESCRIBED_NOTE,
+    remeshable, AccuracyTarget, BAND_MARGIN, COARSE_FACTOR, DEFAULT_ACCURACY_MODES, LEVELS_VERSION,
+    MAX_REFINEMENTS, MAX_STEP, MIN_STEP, PRESCRIBED_NOTE,
 };
 pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, Scale, SurfaceMeshing};
 pub use pipeline::{
