@@ -477,7 +477,8 @@ fn describe_worst(target: &AccuracyTarget, kept: &LevelEstimate, hz: &[f64]) -> 
         .take(target.modes)
         .enumerate()
         .filter(|(_, (e, _))| e.is_none())
-        .map(|(i, (_, f))| format!("{} ({f:.0} Hz)", i + 1))
+        // Numbered as `modal info` and `--mode` number them, from 0.
+        .map(|(i, (_, f))| format!("{i} ({f:.0} Hz)"))
         .collect();
     if unmatched.is_empty() {
         return format!(
@@ -573,7 +574,7 @@ mod tests {
         };
         let hz = [637.1, 1484.4, 1685.3, 3075.8];
         let said = describe_worst(&target, &kept, &hz);
-        assert!(said.starts_with("mode(s) 2 (1484 Hz) of the lowest 3"), "{said}");
+        assert!(said.starts_with("mode(s) 1 (1484 Hz) of the lowest 3"), "{said}");
         assert!(!said.contains("3076"), "mode 4 is beyond the target's modes: {said}");
         let all = LevelEstimate { error_pct: vec![Some(0.2), Some(0.3), Some(0.1), None], ..kept };
         let worst = describe_worst(&target, &all, &hz);
