@@ -331,6 +331,11 @@ fn material_and_scale_on_a_bank_object_retune_it() {
     let (twice, _) = wav("twice", "bank = \"bar.bank\"\nscale = 2.0");
     let (big, _) = wav("big", "bank = \"big.bank\"");
     assert!(twice == big && twice != steel, "the scale was ignored");
+    // Heard through its transfer: the bank never stored one, which is what is said
+    // (not that a retune dropped it).
+    let heard = modal(d, &["render", "in_al.toml", "-o", "heard.wav"]).ok().stderr;
+    assert!(heard.contains("bar.bank has no radiation table"), "{heard}");
+    assert!(!heard.contains("carry over"), "{heard}");
 }
 
 /// Ctrl-C (SIGINT) of a `--json` run: exit 130, `{"error": "interrupted"}`

@@ -53,8 +53,9 @@ struct PipelineProvider<'a> {
     /// (else the eigensolver's default).
     memory_limit_bytes: Option<u64>,
     /// Bank files retuned to their object's material or scale, each with its
-    /// stored transfer as it carries over (`None`: it does not, or none).
-    retuned: Vec<(BankRequest, Option<RadiationTable>)>,
+    /// stored transfer as it carries over (`None`: it does not, or none) and
+    /// whether the file stored one.
+    retuned: Vec<(BankRequest, Option<RadiationTable>, bool)>,
     /// `--accuracy` of surface-mesh objects (`None`: one solve, no estimate).
     accuracy: Option<modal_precompute::AccuracyTarget>,
 }
@@ -190,12 +191,17 @@ impl BankProvider for PipelineProvider<'_> {
             (None, Some(path)) => path.display().to_string(),
             (None, None) => return Ok(None),
         };
-        if let Some((_, table)) = self.retuned.iter().find(|(r, _)| r == request) {
-            if table.is_none() {
-                self.warnings.push(format!(
-                    "{what}, retuned to the object's material: no stored transfer carries over (E/ρ moved \
-                     every mode to a new ka, or it had none): its level is a pulsating-sphere estimate"
-                ));
+        if let Some((_, table, stored)) = self.retuned.iter().find(|(r, _, _)| r == request) {
+            match (table, stored) {
+                (Some(_), _) => {}
+                (None, false) => self.warnings.push(format!(
+                    "{what} has no radiation table: its level is a pulsating-sphere estimate \
+                     (run `modal radiation BANK --store OUT.bank`)"
+                )),
+                (None, true) => self.warnings.push(format!(
+                    "{what}, retuned to the object's material or scale: its stored transfer does not carry \
+                     over (every mode moved to a new ka): its level is a pulsating-sphere estimate"
+                )),
             }
             return Ok(table.clone().map(Arc::new));
         }
@@ -259,8 +265,9 @@ impl PipelineProvider<'_> {
         let spec = modal_bank::RetuneSpec { material, scale: request.scale };
         let retuned =
             modal_bank::retune(&bank, spec.clone()).map_err(|e| format!("{}: {e}", path.display()))?;
+        let stored = table.is_some();
         let table = table.and_then(|t| modal_bank::retune_radiation(&bank, &t, &spec));
-        self.retuned.push((request.clone(), table));
+        self.retuned.push((request.clone(), table, stored));
         Ok(retuned)
     }
 
