@@ -167,6 +167,9 @@ pub(crate) struct World {
     /// Per object: thinnest extent of its collider (rapier's CCD thickness) [m].
     ccd_thickness_m: Vec<f32>,
     gravity: [f64; 3],
+    /// Objects set on each other at the start (upper, lower), lifted apart
+    /// by [`START_GAP_M`] ([`open_start_gaps`]).
+    pub placed_pairs: Vec<(usize, usize)>,
 }
 
 fn v3(a: [f64; 3]) -> Vector {
@@ -310,7 +313,13 @@ pub const START_GAP_M: f64 = 5e-5;
 /// mesh origin) lies lower, against gravity (+y without gravity), to that
 /// gap, lowest bodies first, so a stack opens from the bottom up. Colliders
 /// sit at their body's pose (no offset), so the body's pose is the collider's.
-fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], scene: &Scene) {
+/// Returns the pairs of objects so set on each other (upper, lower).
+fn open_start_gaps(
+    world: &mut PhysicsWorld,
+    bodies: &[RigidBodyHandle],
+    scene: &Scene,
+) -> Vec<(usize, usize)> {
+    let mut placed = Vec::new();
     let gravity = scene.gravity_m_s2;
     let g = dot(gravity, gravity).sqrt();
     let up = if g > 0.0 { gravity.map(|x| -x / g) } else { [0.0, 1.0, 0.0] };
@@ -323,6 +332,7 @@ fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], scene: 
             if j == i || height[j] >= height[i] {
                 continue;
             }
+            let mut touching = false;
             for a in world.bodies[bodies[i]].colliders() {
                 for b in world.bodies[*other].colliders() {
                     let (a, b) = (&world.colliders[*a], &world.colliders[*b]);
@@ -331,8 +341,12 @@ fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], scene: 
                         rapier3d::parry::query::contact(pa, a.shape(), pb, b.shape(), START_GAP_M as f32)
                     {
                         nearest = nearest.min(c.dist as f64);
+                        touching |= (c.dist as f64) < START_GAP_M;
                     }
                 }
+            }
+            if touching {
+                placed.push((i, j));
             }
         }
         if nearest < START_GAP_M {
@@ -342,6 +356,7 @@ fn open_start_gaps(world: &mut PhysicsWorld, bodies: &[RigidBodyHandle], scene: 
             body.set_translation(v3([t[0] + lift * up[0], t[1] + lift * up[1], t[2] + lift * up[2]]), false);
         }
     }
+    placed
 }
 
 /// How deep the point `p` (world frame) lies inside `collider`'s solid [m], 0
@@ -427,7 +442,7 @@ impl World {
         let pre_step = vec![([0.0; 3], [0.0; 3], [0.0; 3]); bodies.len()];
         let n_objects = bodies.len();
         check_overlaps(&world, &bodies, scene)?;
-        open_start_gaps(&mut world, &bodies, scene);
+        let placed_pairs = open_start_gaps(&mut world, &bodies, scene);
         let rolling_m = scene.objects.iter().map(|o| o.rolling_resistance_m).collect();
         let fixed_com =
             scene.objects.iter().map(|o| (o.body != BodyKind::Dynamic).then_some(o.position_m)).collect();
@@ -445,6 +460,7 @@ impl World {
             normal_ns,
             ccd_thickness_m,
             gravity: scene.gravity_m_s2,
+            placed_pairs,
         })
     }
 

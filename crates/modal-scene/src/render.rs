@@ -230,7 +230,7 @@ fn simulate(
         }
     };
     record(&world, &mut sim);
-    let mut exciter = Exciter::default();
+    let mut exciter = Exciter::with_placed(&world.placed_pairs);
     let gravity = scene.gravity_m_s2.iter().map(|g| g * g).sum::<f64>().sqrt();
     let mut sustainer = scene.sustained.then(|| Sustainer::new(scene.sample_rate_hz as f64, dt, gravity));
     let mut pairs: Vec<PairContacts> = Vec::new();
