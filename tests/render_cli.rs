@@ -309,7 +309,10 @@ fn material_and_scale_on_a_bank_object_retune_it() {
         "{}",
         retuned.stderr
     );
-    modal(d, &["retune", "bar.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    let big = modal(d, &["retune", "bar.bank", "--scale", "2", "-o", "big.bank"]).ok();
+    // Twice the size, every mode an octave down: the band's top octave is empty, and said.
+    assert!(big.stderr.contains("every mode moved down × 0.500"), "{}", big.stderr);
+    assert!(!retuned.stderr.contains("moved down"), "aluminium rings higher: {}", retuned.stderr);
     let wav = |name: &str, object: &str| {
         let scene = format!(
             "duration = 0.3\nsample_rate = 16000\n[listener]\nposition = [0.0, 0.2, 0.5]\nchannels = \"mono\"\n\

@@ -244,7 +244,7 @@ pub struct PrecomputeArgs {
     #[arg(long, value_name = "HZ", default_value_t = 20.0)]
     pub min_freq: f64,
     /// Highest frequency kept [Hz] (no upper cap: ultrasonic bands are legal).
-    #[arg(long, value_name = "HZ", default_value_t = 20_000.0)]
+    #[arg(long, value_name = "HZ", default_value_t = modal_precompute::DEFAULT_MAX_FREQ_HZ)]
     pub max_freq: f64,
     /// Clamp every node inside the box X0,Y0,Z0,X1,Y1,Z1 [m].
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box, allow_hyphen_values = true)]

@@ -61,6 +61,9 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
     let material = material_given.then(|| retuned_material(&bank, &args)).transpose()?;
     let spec = RetuneSpec { material, scale: args.scale };
     let new = modal_bank::retune(&bank, spec.clone())?;
+    if let Some(said) = emptied_band_warning(&bank, &new) {
+        warn(&said);
+    }
     super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;
     let transfer = match stored {
         Some(table) => {
@@ -86,6 +89,36 @@ pub fn retune(args: RetuneArgs) -> Result<()> {
         println!("wrote {}", args.out.display());
     }
     Ok(())
+}
+
+/// When a retune lowers every mode (a larger size, a softer or denser
+/// material), the top of the band the bank was solved to is left empty: the
+/// modes above its highest were never solved. Said when the new highest mode
+/// falls below the default band's 20 kHz (a bar retuned × 2: 21 modes ending
+/// at 9.83 kHz, where a new solve fills the band to 15.6 kHz and beyond).
+fn emptied_band_warning(old: &ModeBank, new: &ModeBank) -> Option<String> {
+    let (&was, &now) = (old.frequencies_hz.last()?, new.frequencies_hz.last()?);
+    if !(now < was && now < modal_precompute::DEFAULT_MAX_FREQ_HZ) {
+        return None;
+    }
+    Some(format!(
+        "every mode moved down × {:.3}: the bank now ends at {} (was {}); modes the solve left above {} were \
+         never solved, so nothing rings above {} — precompute the retuned object to fill the band",
+        now / was,
+        hz(now),
+        hz(was),
+        hz(was),
+        hz(now)
+    ))
+}
+
+/// A frequency in Hz or kHz, 3 significant figures.
+fn hz(f: f64) -> String {
+    if f >= 1000.0 {
+        format!("{:.3} kHz", f / 1000.0)
+    } else {
+        format!("{f:.1} Hz")
+    }
 }
 
 /// The new material: a preset, or the bank's own with the given values replaced.

@@ -26,7 +26,7 @@ pub use levels::{
 pub use load::{is_surface_file, load_mesh, LoadedMesh, MeshSource, Scale, SurfaceMeshing};
 pub use pipeline::{
     assemble_matrices, check_threads, precompute, residual_floor_warning, Assembled, Outcome, Request, Stage,
-    MAX_MODES, MAX_THREADS, TARGET_RESIDUAL,
+    DEFAULT_MAX_FREQ_HZ, MAX_MODES, MAX_THREADS, TARGET_RESIDUAL,
 };
 
 /// Version of the numerical pipeline; part of every cache key, so changing

@@ -52,6 +52,9 @@ pub struct Request {
     pub memory_limit_bytes: Option<u64>,
 }
 
+/// Top of the default band [Hz] (`precompute --max-freq`).
+pub const DEFAULT_MAX_FREQ_HZ: f64 = 20_000.0;
+
 impl Request {
     /// A request with the CLI defaults: order 2, 20 Hz – 20 kHz, 64 modes; no
     /// accuracy target (the CLI's `precompute` sets `--accuracy 1`).
@@ -64,7 +67,7 @@ impl Request {
             material,
             order: 2,
             min_freq_hz: 20.0,
-            max_freq_hz: 20_000.0,
+            max_freq_hz: DEFAULT_MAX_FREQ_HZ,
             max_modes: 64,
             fix_box: None,
             threads: None,
