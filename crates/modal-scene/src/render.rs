@@ -50,7 +50,7 @@ use rayon::prelude::*;
 use crate::excite::{Exciter, ImpactEvent, StepInput, StepStrikes, Strike};
 use crate::ground::with_slab;
 use crate::listener::{listening_points, mix, Trajectory};
-use crate::physics::{check_ground_clearance, PairContacts, World};
+use crate::physics::{check_ground_clearance, ContactSide, PairContacts, World};
 use crate::provider::resolve_banks;
 pub use crate::report::{ObjectReport, RenderReport};
 use crate::spec::{Radiation, Scene};
@@ -172,6 +172,7 @@ pub fn render(
             strikes: sim.strikes[i].len(),
             force_segments: sim.segments[i].len(),
             final_position_m: paths[i].positions.last().map_or([0.0; 3], |p| p.map(f64::from)),
+            ground_depth_m: sim.ground_depth_m[i],
             ..s.report.clone()
         });
     }
@@ -187,6 +188,20 @@ pub fn render(
     })
 }
 
+/// Raises each object's deepest contact with the ground (its side has no
+/// object) to this step's.
+fn record_ground_depth(pairs: &[PairContacts], sides: &[ContactSide], deepest_m: &mut [f64]) {
+    for pair in pairs {
+        let objects = pair.sides.map(|s| sides[s].object);
+        let object = match objects {
+            [Some(i), None] | [None, Some(i)] => i,
+            _ => continue,
+        };
+        let depth = pair.points.iter().map(|p| -p.separation_m).fold(0.0, f64::max);
+        deepest_m[object] = deepest_m[object].max(depth);
+    }
+}
+
 struct Simulation {
     strikes: Vec<Vec<Strike>>,
     /// Per object: sustained-contact force segments.
@@ -196,6 +211,8 @@ struct Simulation {
     trajectories: Vec<Trajectory>,
     events: Vec<ImpactEvent>,
     events_total: usize,
+    /// Per object: deepest into the ground plane [m] (`ObjectReport::ground_depth_m`).
+    ground_depth_m: Vec<f64>,
 }
 
 fn simulate(
@@ -220,6 +237,7 @@ fn simulate(
         trajectories: vec![Trajectory { dt, positions: Vec::new(), rotations: Vec::new() }; n],
         events: Vec::new(),
         events_total: 0,
+        ground_depth_m: vec![0.0; n],
     };
     let record = |world: &World, sim: &mut Simulation| {
         for (i, path) in sim.trajectories.iter_mut().enumerate() {
@@ -244,6 +262,7 @@ fn simulate(
         world.step();
         world.contacts(&mut pairs);
         world.resist_rolling(&pairs);
+        record_ground_depth(&pairs, &world.sides, &mut sim.ground_depth_m);
         report.physics_s += t.elapsed().as_secs_f64();
         report.physics_steps += 1;
         let t = Instant::now();
