@@ -379,8 +379,15 @@ fn print_human(json: &StrikeJson) {
         );
     }
     println!(
-        "wrote {} ({:.3} s at {} Hz, peak {:.3} of full scale, {} of {} modes skipped as inaudible)",
-        json.out, json.duration_s, json.sample_rate, json.peak, json.modes_skipped, json.modes_total
+        "wrote {} ({:.3} s at {} Hz, peak {:.3} of full scale, {} of {} modes skipped: below 20 Hz, above \
+         0.45 × the rate ({:.0} Hz) or overdamped)",
+        json.out,
+        json.duration_s,
+        json.sample_rate,
+        json.peak,
+        json.modes_skipped,
+        json.modes_total,
+        modal_synth::MAX_FREQUENCY_FRACTION * json.sample_rate as f64
     );
     println!(
         "work: {} mode-samples over {} computed samples; {} modes culled once below the threshold",
