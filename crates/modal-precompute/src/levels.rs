@@ -350,15 +350,15 @@ pub(crate) fn solve_to_accuracy(
         // The cell factor to advise: none for a mode without an estimate, about which the
         // model says nothing.
         let advised = worst.map(|_| wanted.min(MAX_STEP));
+        let guard = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
+        let advice =
+            |f: f64| cell_advice(fine.cell_m * f, fine.memory as f64 * f.powi(-4), guard, target.target_pct);
         if prescribed {
             let cell = request.surface.cell.unwrap_or_default();
-            let advice = advised.map_or(String::new(), |f| {
-                format!("; about --cell {:.4e} m would reach {} %", cell * f, target.target_pct)
-            });
+            let advice = advised.map_or(String::new(), |f| format!("; {}", advice(f)));
             warnings.push(format!("{reached} at the given --cell {cell:.4e} m{advice}"));
             return Ok((bank, warnings, coarsened));
         }
-        let guard = request.memory_limit_bytes.or_else(modal_eigen::default_memory_limit);
         let next = NextLevel { memory: fine.memory, seconds: fine.seconds, spent, step };
         if let Some(stop) = next.refused(refinement, guard) {
             let cell = fine.cell_m * step;
@@ -371,10 +371,7 @@ pub(crate) fn solve_to_accuracy(
                 Stop::Time { predicted_s } => format!(
                     "the next finer level (cell {cell:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
                      time budget of {TIME_BUDGET_S:.0} s{}",
-                    advised.map_or(String::new(), |f| format!(
-                        " (about --cell {:.2e} m would reach the target)",
-                        fine.cell_m * f
-                    ))
+                    advised.map_or(String::new(), |f| format!(" ({})", advice(f)))
                 ),
                 Stop::Refinements => format!("stopped after {MAX_REFINEMENTS} refinements"),
             };
@@ -458,6 +455,23 @@ impl NextLevel {
             _ if refinement == MAX_REFINEMENTS => Some(Stop::Refinements),
             _ => None,
         }
+    }
+}
+
+/// The `--cell` the estimate's model says would reach `target_pct`, and
+/// whether this machine could solve it: its solver memory predicted as the
+/// levels' own, `memory · (s/s')⁴` (`predicted_bytes`), against `guard`. A
+/// scanned bunny's 142 % on its ears advised `--cell 4.04e-4 m`, ≈ 10⁸ DOF,
+/// as if it were a step away.
+fn cell_advice(cell_m: f64, predicted_bytes: f64, guard: Option<u64>, target_pct: f64) -> String {
+    match guard {
+        Some(guard) if predicted_bytes > guard as f64 => format!(
+            "reaching {target_pct} % would take about --cell {cell_m:.2e} m and ≈ {:.0} GB (this level's memory \
+             × (cell ratio)⁴), beyond the memory guard of {:.1} GB",
+            predicted_bytes / 1e9,
+            guard as f64 / 1e9
+        ),
+        _ => format!("about --cell {cell_m:.2e} m would reach {target_pct} %"),
     }
 }
 
@@ -561,6 +575,16 @@ mod tests {
         assert!(joined.contains("both split or join") && joined.contains("rough bound"), "{joined}");
         let failed = mild_outcome(2, Err("the mesher refused".into())).expect("a failure: a warning");
         assert!(failed.contains("failed: the mesher refused") && failed.contains("rough bound"), "{failed}");
+    }
+
+    #[test]
+    fn a_cell_beyond_the_memory_guard_is_advised_as_such() {
+        let gb = 1e9 as u64;
+        assert_eq!(cell_advice(2e-3, 3e9, Some(18 * gb), 1.0), "about --cell 2.00e-3 m would reach 1 %");
+        assert_eq!(cell_advice(2e-3, 3e12, None, 1.0), "about --cell 2.00e-3 m would reach 1 %");
+        let far = cell_advice(4.04e-4, 6.9e12, Some(18 * gb), 1.0);
+        assert!(far.starts_with("reaching 1 % would take about --cell 4.04e-4 m and ≈ 6900 GB"), "{far}");
+        assert!(far.contains("beyond the memory guard of 18.0 GB"), "{far}");
     }
 
     #[test]
