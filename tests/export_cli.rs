@@ -281,5 +281,7 @@ fn a_stored_transfer_survives_the_gltf_round_trip() {
     // A glTF output must be named .glb: the file is binary.
     modal(dir.path(), &["export", "rad.bank", "--gltf", "rad.gltf"]).fails_with("give it a .glb name");
     modal(dir.path(), &["export", "rad.bank", "--gltf", "rad2.bank"]).fails_with("give it a .glb name");
+    modal(dir.path(), &["export", "rad.bank", "--vtk", "rad.txt"]).fails_with("give it a .vtu name");
+    assert!(!dir.path().join("rad.txt").exists());
     assert!(!dir.path().join("rad.gltf").exists() && !dir.path().join("rad2.bank").exists());
 }

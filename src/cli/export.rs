@@ -128,6 +128,15 @@ pub fn run(args: ExportArgs) -> Result<()> {
     for (flag, path) in &outputs {
         super::check_not_input(path, &args.bank, flag)?;
     }
+    if let Some(path) = &args.vtk {
+        // ParaView picks its reader by the extension: x.txt opened as text.
+        let vtu = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("vtu"));
+        anyhow::ensure!(
+            vtu,
+            "--vtk {}: the file is a VTK XML unstructured grid; give it a .vtu name",
+            path.display()
+        );
+    }
     let (bank, radiation) = load_bank_with_radiation(&args.bank)?;
     for (flag, path) in &outputs {
         super::prepare_output(path).with_context(|| format!("cannot write {flag} {}", path.display()))?;
