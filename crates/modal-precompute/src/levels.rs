@@ -363,10 +363,13 @@ pub(crate) fn solve_to_accuracy(
         if let Some(stop) = next.refused(refinement, guard) {
             let cell = fine.cell_m * step;
             let why = match stop {
-                Stop::Memory { predicted, guard } => format!(
-                    "the next finer level (cell {cell:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB",
+                Stop::Memory { predicted, guard, late_s } => format!(
+                    "the next finer level (cell {cell:.2e} m) would need ≈ {:.1} GB, above the memory guard of {:.1} GB{}",
                     predicted / 1e9,
-                    guard as f64 / 1e9
+                    guard as f64 / 1e9,
+                    late_s.map_or(String::new(), |s| format!(
+                        ", and ≈ {s:.0} s more, past the time budget of {TIME_BUDGET_S:.0} s ({spent:.0} s spent)"
+                    ))
                 ),
                 Stop::Time { predicted_s } => format!(
                     "the next finer level (cell {cell:.2e} m) would take ≈ {predicted_s:.0} s more, beyond the \
@@ -427,8 +430,10 @@ fn mild_outcome(fine_parts: usize, mild_parts: Result<usize, String>) -> Option<
 enum Stop {
     /// [`MAX_REFINEMENTS`] reached.
     Refinements,
-    /// Predicted solver memory [bytes] above the guard.
-    Memory { predicted: f64, guard: u64 },
+    /// Predicted solver memory [bytes] above the guard; with the predicted
+    /// wall time [s] when that is past [`TIME_BUDGET_S`] too (more memory alone
+    /// would not let the level run).
+    Memory { predicted: f64, guard: u64, late_s: Option<f64> },
     /// Predicted wall time [s] of the next level would pass [`TIME_BUDGET_S`].
     Time { predicted_s: f64 },
 }
@@ -450,7 +455,10 @@ impl NextLevel {
         let predicted = self.memory as f64 * (1.0 / self.step).powi(4);
         let predicted_s = self.seconds * (1.0 / self.step).powi(TIME_EXPONENT);
         match guard {
-            Some(guard) if predicted > guard as f64 => Some(Stop::Memory { predicted, guard }),
+            Some(guard) if predicted > guard as f64 => {
+                let late_s = (self.spent + predicted_s > TIME_BUDGET_S).then_some(predicted_s);
+                Some(Stop::Memory { predicted, guard, late_s })
+            }
             _ if self.spent + predicted_s > TIME_BUDGET_S => Some(Stop::Time { predicted_s }),
             _ if refinement == MAX_REFINEMENTS => Some(Stop::Refinements),
             _ => None,
@@ -611,7 +619,14 @@ mod tests {
         let next = NextLevel { memory: 1_000_000_000, seconds: 2.0, spent: 3.0, step: 0.5 };
         assert_eq!(
             next.refused(0, Some(8_000_000_000)),
-            Some(Stop::Memory { predicted: 16e9, guard: 8_000_000_000 })
+            Some(Stop::Memory { predicted: 16e9, guard: 8_000_000_000, late_s: Some(128.0) })
+        );
+        // Memory alone: said alone (a scanned dragon's level after 90 s was told only of
+        // its 34 GB, though the time budget was spent too).
+        let quick = NextLevel { seconds: 0.1, ..next };
+        assert_eq!(
+            quick.refused(0, Some(8_000_000_000)),
+            Some(Stop::Memory { predicted: 16e9, guard: 8_000_000_000, late_s: None })
         );
         assert_eq!(next.refused(0, Some(32_000_000_000)), Some(Stop::Time { predicted_s: 128.0 }));
         // Step 0.8: 2.44 GB and 7.6 s, 10.6 s with the 3 s spent: inside both limits.
