@@ -152,42 +152,46 @@ impl SynthModel {
 
     /// Where a tap along the surface normal rings the lowest modes most: the
     /// centroid of the corner triangle `T` maximizing
-    /// `Σ_{i < K} (v_i(T) / max_T' |v_i(T')|)²`, `v_i(T)` the mean normal
-    /// shape `φ_i·n_T` over `T`'s corners and `K` = [`RINGING_MODES`] (each
-    /// mode weighs the same, whatever its normalization). A bar is struck on
-    /// its broad face at an end, a bowl or a bell radially at the rim, a
-    /// plate across its face at the edge: where a player strikes them, and
-    /// where the body's farthest point (a corner, whose tap points along the
-    /// bar's axis) is not. Only faces turned away from the centre of mass
-    /// are candidates (struck from outside). `None` without modes or a
-    /// non-degenerate triangle.
+    /// `Σ_{i < K} p_i (v_i(T) / max_T' |v_i(T')|)²`, `v_i(T)` the mean normal
+    /// shape `φ_i·n_T` over `T`'s corners, `K` = [`RINGING_MODES`] and
+    /// `p_i = rms(v_i)² / max|v_i|²` (area-weighted) the share of the surface
+    /// mode `i` moves: a mode of the whole body weighs more than one of a
+    /// handle, an ear or a foot, whose maximum is as large but on a small
+    /// part (a mug was struck on its handle and a wine glass under its foot
+    /// when every mode weighed the same; now at the rim). A bar is struck on
+    /// its broad face at an end, a bowl or a bell radially at the rim, a plate
+    /// across its face at the edge: where a player strikes them, and where
+    /// the body's farthest point (a corner, whose tap points along the bar's
+    /// axis) is not. Only faces turned away from the centre of mass are
+    /// candidates (struck from outside); of equal scores (a symmetric body's
+    /// faces) the highest in y, then z. Without modes, the first such face.
+    /// `None` without a non-degenerate triangle.
     pub fn ringing_point(&self) -> Option<[f64; 3]> {
         let s = self.surface();
-        let nodes = s.positions.len();
         let faces = TriangleNormals::new(s);
-        let modes = self.mode_count().min(RINGING_MODES);
-        if modes == 0 || faces.triangles.is_empty() {
+        if faces.triangles.is_empty() {
             return None;
         }
-        // v[i][t]: mode i's mean normal shape over triangle t.
-        let v: Vec<Vec<f64>> = (0..modes)
-            .map(|i| {
-                let mode = &self.bank.shapes[i * nodes * 3..(i + 1) * nodes * 3];
-                let normal_shape = |k: usize, n: &[f64; 3]| {
-                    let sh = &mode[k * 3..k * 3 + 3];
-                    sh[0] as f64 * n[0] + sh[1] as f64 * n[1] + sh[2] as f64 * n[2]
-                };
-                faces
-                    .triangles
-                    .iter()
-                    .zip(&faces.area_normal)
-                    .map(|(tri, (_, n))| tri.iter().map(|&k| normal_shape(k, n)).sum::<f64>() / 3.0)
-                    .collect()
+        let modes = self.mode_count().min(RINGING_MODES);
+        let v: Vec<Vec<f64>> = (0..modes).map(|i| self.mean_normal_shapes(i, &faces)).collect();
+        let largest: Vec<f64> = v.iter().map(|vi| vi.iter().fold(0.0, |m: f64, x| m.max(x.abs()))).collect();
+        let participation: Vec<f64> = v
+            .iter()
+            .zip(&largest)
+            .map(|(vi, &l)| {
+                let mean_square = vi.iter().zip(&faces.area_normal).map(|(x, (a, _))| a * x * x).sum::<f64>();
+                if l > 0.0 {
+                    mean_square / faces.area_total / (l * l)
+                } else {
+                    0.0
+                }
             })
             .collect();
-        let largest: Vec<f64> = v.iter().map(|vi| vi.iter().fold(0.0, |m: f64, x| m.max(x.abs()))).collect();
         let score = |t: usize| -> f64 {
-            (0..modes).filter(|&i| largest[i] > 0.0).map(|i| (v[i][t] / largest[i]).powi(2)).sum()
+            (0..modes)
+                .filter(|&i| largest[i] > 0.0)
+                .map(|i| participation[i] * (v[i][t] / largest[i]).powi(2))
+                .sum()
         };
         let centroid = |t: usize| {
             let corners = faces.triangles[t].map(|k| s.positions[k]);
@@ -203,14 +207,43 @@ impl SynthModel {
         };
         let scores: Vec<f64> =
             (0..faces.triangles.len()).map(|t| if outer(t) { score(t) } else { f64::NEG_INFINITY }).collect();
-        // The first of equals: the same point on every run.
-        let best = (0..scores.len()).fold(0, |best, t| if scores[t] > scores[best] { t } else { best });
+        let top = scores.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        // Equal within rounding: a plate's top and bottom, a disc's rim all round.
+        let tie = top - 1e-9 * top.abs();
+        let height = |t: usize| {
+            let c = centroid(t);
+            (c[1], c[2])
+        };
+        let best =
+            (0..scores.len()).filter(|&t| scores[t] >= tie).fold(
+                None,
+                |best: Option<usize>, t| match best {
+                    Some(b) if height(b) >= height(t) => Some(b),
+                    _ => Some(t),
+                },
+            )?;
         Some(centroid(best))
+    }
+
+    /// Mode `i`'s normal shape `φ_i·n_T` averaged over each triangle's corners.
+    fn mean_normal_shapes(&self, i: usize, faces: &TriangleNormals) -> Vec<f64> {
+        let nodes = self.surface().positions.len();
+        let mode = &self.bank.shapes[i * nodes * 3..(i + 1) * nodes * 3];
+        let normal_shape = |k: usize, n: &[f64; 3]| {
+            let sh = &mode[k * 3..k * 3 + 3];
+            sh[0] as f64 * n[0] + sh[1] as f64 * n[1] + sh[2] as f64 * n[2]
+        };
+        faces
+            .triangles
+            .iter()
+            .zip(&faces.area_normal)
+            .map(|(tri, (_, n))| tri.iter().map(|&k| normal_shape(k, n)).sum::<f64>() / 3.0)
+            .collect()
     }
 }
 
 /// How many of the lowest modes [`SynthModel::ringing_point`] rings.
-pub const RINGING_MODES: usize = 4;
+pub const RINGING_MODES: usize = 8;
 
 /// The non-degenerate corner triangles of a surface with their areas and
 /// outward unit normals, and the total area \[m²\].
@@ -348,12 +381,13 @@ mod tests {
         let p = model.ringing_point().expect("a point");
         let on_outer_wall = p.iter().any(|&c| c == 0.0 || c == 1.0);
         assert!(on_outer_wall, "{p:?} is not on the outer wall");
-        // Without modes there is nothing to ring.
+        // Without modes (a bank whose band holds none): an outer face, not an error.
         bank.frequencies_hz.clear();
         bank.decay_rates.clear();
         bank.damping_ratios.clear();
         bank.shapes.clear();
-        assert_eq!(SynthModel::new(&bank).expect("model").ringing_point(), None);
+        let silent = SynthModel::new(&bank).expect("model").ringing_point().expect("a point");
+        assert!(silent.iter().any(|&c| c == 0.0 || c == 1.0), "{silent:?} is not on the outer wall");
     }
 
     #[test]
