@@ -20,6 +20,7 @@ mod precompute;
 mod progress;
 mod radiation;
 mod render;
+mod scene_warnings;
 mod strike;
 
 use std::process::ExitCode;
