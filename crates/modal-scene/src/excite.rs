@@ -24,10 +24,11 @@
 //!
 //! **Bodies set on each other** (a stack at rest, a block on a table) touch
 //! from the start: their pair's first touch is a continuing contact (as if
-//! it touched at t = 0, so within [`RECONTACT_WINDOW_S`]), not a new one. The solver's settling under the stack's load closes such
-//! a pair at a few cm/s (a tower of five 5 cm wooden blocks at 0.056 m/s
-//! after 6 ms, a click); a new contact strikes from [`MIN_APPROACH_M_S`],
-//! a continuing one only from [`MIN_APPROACH_CONTINUING_M_S`].
+//! it touched at t = 0, so within [`RECONTACT_WINDOW_S`]), not a new one.
+//! The solver's settling under the stack's load closes such a pair at a few
+//! cm/s (a tower of five 5 cm wooden blocks at 0.056 m/s after 6 ms, a
+//! click); a new contact strikes from [`MIN_APPROACH_M_S`], a continuing one
+//! only from [`MIN_APPROACH_CONTINUING_M_S`].
 //!
 //! **Onset time.** For a pair that was not touching, the contact begins
 //! within the step at `t_k + clamp(s / v_n, 0, dt)`, with `s` the separation
