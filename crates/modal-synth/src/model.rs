@@ -107,15 +107,9 @@ impl SynthModel {
     pub fn shapes_dot(&self, p: &SurfacePoint, v: [f64; 3], out: &mut [f64]) {
         assert_eq!(out.len(), self.mode_count(), "shapes_dot: output length");
         let w = node_weights(self.surface(), p);
-        let nodes = self.surface().positions.len();
         for (i, o) in out.iter_mut().enumerate() {
-            let mut acc = 0.0;
-            for k in 0..w.len {
-                let b = (i * nodes + w.nodes[k]) * 3;
-                let s = &self.bank.shapes[b..b + 3];
-                acc += w.weights[k] * (s[0] as f64 * v[0] + s[1] as f64 * v[1] + s[2] as f64 * v[2]);
-            }
-            *o = acc;
+            let mode = self.mode_shape(i);
+            *o = (0..w.len).map(|k| w.weights[k] * normal_component(mode, w.nodes[k], &v)).sum();
         }
     }
 
@@ -127,20 +121,12 @@ impl SynthModel {
     /// reads only its own (contiguous) shape block, summing over triangles
     /// in index order.
     pub fn rms_normal_shapes(&self) -> Vec<f64> {
-        let s = self.surface();
-        let nodes = s.positions.len();
-        let faces = TriangleNormals::new(s);
-        let shapes = &self.bank.shapes;
+        let faces = TriangleNormals::new(self.surface());
         let mut acc = vec![0.0; self.mode_count()];
         for (i, g) in acc.iter_mut().enumerate() {
-            let mode = &shapes[i * nodes * 3..(i + 1) * nodes * 3];
+            let mode = self.mode_shape(i);
             for (tri, (area, un)) in faces.triangles.iter().zip(&faces.area_normal) {
-                let mut sq = 0.0;
-                for &k in tri {
-                    let sh = &mode[k * 3..k * 3 + 3];
-                    let d = sh[0] as f64 * un[0] + sh[1] as f64 * un[1] + sh[2] as f64 * un[2];
-                    sq += d * d;
-                }
+                let sq: f64 = tri.iter().map(|&k| normal_component(mode, k, un).powi(2)).sum();
                 *g += area * sq / 3.0;
             }
         }
@@ -193,16 +179,20 @@ impl SynthModel {
                 .map(|i| participation[i] * (v[i][t] / largest[i]).powi(2))
                 .sum()
         };
-        let centroid = |t: usize| {
-            let corners = faces.triangles[t].map(|k| s.positions[k]);
-            [0, 1, 2].map(|c| (corners[0][c] + corners[1][c] + corners[2][c]) / 3.0)
-        };
+        let centroids: Vec<[f64; 3]> = faces
+            .triangles
+            .iter()
+            .map(|tri| {
+                let corners = tri.map(|k| s.positions[k]);
+                [0, 1, 2].map(|c| (corners[0][c] + corners[1][c] + corners[2][c]) / 3.0)
+            })
+            .collect();
         // Struck from outside: a face turned away from the centre of mass (a
         // tube's or a cup's inside rings as its outside does, but is not
         // where a tap comes from). A closed surface always has such faces.
         let com = self.bank.mass.center_of_mass_m;
         let outer = |t: usize| {
-            let (c, n) = (centroid(t), faces.area_normal[t].1);
+            let (c, n) = (centroids[t], faces.area_normal[t].1);
             (0..3).map(|k| (c[k] - com[k]) * n[k]).sum::<f64>() > 0.0
         };
         let scores: Vec<f64> =
@@ -210,10 +200,7 @@ impl SynthModel {
         let top = scores.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         // Equal within rounding: a plate's top and bottom, a disc's rim all round.
         let tie = top - 1e-9 * top.abs();
-        let height = |t: usize| {
-            let c = centroid(t);
-            (c[1], c[2])
-        };
+        let height = |t: usize| (centroids[t][1], centroids[t][2]);
         let best =
             (0..scores.len()).filter(|&t| scores[t] >= tie).fold(
                 None,
@@ -222,24 +209,31 @@ impl SynthModel {
                     _ => Some(t),
                 },
             )?;
-        Some(centroid(best))
+        Some(centroids[best])
     }
 
     /// Mode `i`'s normal shape `φ_i·n_T` averaged over each triangle's corners.
     fn mean_normal_shapes(&self, i: usize, faces: &TriangleNormals) -> Vec<f64> {
-        let nodes = self.surface().positions.len();
-        let mode = &self.bank.shapes[i * nodes * 3..(i + 1) * nodes * 3];
-        let normal_shape = |k: usize, n: &[f64; 3]| {
-            let sh = &mode[k * 3..k * 3 + 3];
-            sh[0] as f64 * n[0] + sh[1] as f64 * n[1] + sh[2] as f64 * n[2]
-        };
+        let mode = self.mode_shape(i);
         faces
             .triangles
             .iter()
             .zip(&faces.area_normal)
-            .map(|(tri, (_, n))| tri.iter().map(|&k| normal_shape(k, n)).sum::<f64>() / 3.0)
+            .map(|(tri, (_, n))| tri.iter().map(|&k| normal_component(mode, k, n)).sum::<f64>() / 3.0)
             .collect()
     }
+
+    /// Mode `i`'s shape at every surface node, `[x, y, z]` per node.
+    fn mode_shape(&self, i: usize) -> &[f32] {
+        let nodes = self.surface().positions.len();
+        &self.bank.shapes[i * nodes * 3..(i + 1) * nodes * 3]
+    }
+}
+
+/// `φ(k)·n` for surface node `k` of one mode's shape block (`n` any vector).
+fn normal_component(mode: &[f32], k: usize, n: &[f64; 3]) -> f64 {
+    let sh = &mode[k * 3..k * 3 + 3];
+    sh[0] as f64 * n[0] + sh[1] as f64 * n[1] + sh[2] as f64 * n[2]
 }
 
 /// How many of the lowest modes [`SynthModel::ringing_point`] rings.
