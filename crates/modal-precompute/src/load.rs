@@ -208,7 +208,7 @@ pub(crate) fn load_mesh_sized(
         return Err(PrecomputeError::Invalid(format!("--scale {why}")));
     }
     let mut warnings = Vec::new();
-    let (mut cell_m, mut layered, mut surface_bodies, mut surface_volume_m3) = (None, false, None, None);
+    let (mut cell_m, mut layered, mut surface_bodies, mut volume_kept) = (None, false, None, None);
     let raw = match source {
         MeshSource::File(path) if is_surface_file(path) => {
             let (surf, mut report) = modal_tetra::read_surface(path, factor, surface.part.as_deref())?;
@@ -239,7 +239,9 @@ pub(crate) fn load_mesh_sized(
             warnings.extend(tet_report.warnings);
             cell_m = Some(tet_report.cell_m);
             layered = tet_report.wall_layers > 0;
-            surface_volume_m3 = Some(tet_report.surface_volume_m3).filter(|v| *v > 0.0);
+            // As the mesher measured it (and warns when it is small).
+            volume_kept = (tet_report.surface_volume_m3 > 0.0)
+                .then(|| tet_report.volume_m3 / tet_report.surface_volume_m3);
             mesh
         }
         MeshSource::File(path) => {
@@ -275,7 +277,5 @@ pub(crate) fn load_mesh_sized(
     let (mesh, report) = modal_mesh::check(raw)?;
     warnings.extend(report.warnings.iter().cloned());
     let (parts, part_of_node) = modal_mesh::connected_parts(&mesh);
-    // (The mesher warns when it is small.)
-    let volume_kept = surface_volume_m3.map(|v| modal_mesh::mesh_volume(&mesh) / v);
     Ok(LoadedMesh { mesh, parts, part_of_node, warnings, cell_m, layered, surface_bodies, volume_kept })
 }
