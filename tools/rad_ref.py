@@ -31,13 +31,16 @@ two are independent:
   split into (2R)^2 flat triangles; the velocity there is the quadratic
   interpolation of the shape and the normal is the quadratic triangle's own
   normal (d x/d xi cross d x/d eta) at that point, no averaging between
-  triangles. A linear bank uses its flat triangles (split R^2 times).
+  triangles. With --velocity l2 each flat triangle's DP1 velocity is instead
+  the L2 projection of that quadratic field over it (so it carries the
+  field's exact flux; nodal sampling does not: a quadratic triangle's corner
+  shape functions integrate to zero). A linear bank uses its flat triangles (split R^2 times).
   R = 0: the corner triangles only (velocity and normal at the corners, linear
   in between): 16x fewer element pairs, for low frequencies.
 
 Usage:
     rad_ref.py BANK --point X,Y,Z [--point ...] [--sphere-points N,FACTOR]
-               [--mode I ...] [--refine R]
+               [--mode I ...] [--refine R] [--velocity nodes|l2]
                [--air-density 1.21] [--sound-speed 343] [-o OUT.json]
         prints (or writes) {"modes": [{"index", "frequency_hz",
         "pressure_pa": [[re, im], ...]}], ...}: the same layout as
@@ -116,7 +119,7 @@ def load_bank(path):
     }
 
 
-def refined_surface(bank, refine, modes):
+def refined_surface(bank, refine, modes, velocity="nodes"):
     """Flat triangles sampled on each bank triangle's own (quadratic or linear)
     map. Returns vertices (N, 3), triangles (M, 3) and, per triangle corner,
     the normal velocity of each mode (len(modes), M, 3)."""
@@ -148,8 +151,45 @@ def refined_surface(bank, refine, modes):
     p_count = len(xi)
     glob = inverse.reshape(t, p_count)
     elements = glob[:, sub].reshape(-1, 3)  # (t * s, 3)
-    vn_corner = vn[:, np.arange(t)[:, None, None], sub[None, :, :]].reshape(len(modes), -1, 3)
+    if velocity == "l2":
+        vn_corner = l2_corner_values(bank, nodes, xi, eta, sub, modes, quadratic).reshape(len(modes), -1, 3)
+    else:
+        vn_corner = vn[:, np.arange(t)[:, None, None], sub[None, :, :]].reshape(len(modes), -1, 3)
     return verts, elements, vn_corner
+
+
+# Dunavant's 6-point rule on a triangle (barycentric points, weights summing
+# to 1): exact for polynomials of degree 4.
+_D4_A, _D4_B = 0.445948490915965, 0.091576213509771
+DUNAVANT4_POINTS = np.array([[_D4_A, _D4_A, 1 - 2 * _D4_A], [_D4_A, 1 - 2 * _D4_A, _D4_A],
+                             [1 - 2 * _D4_A, _D4_A, _D4_A], [_D4_B, _D4_B, 1 - 2 * _D4_B],
+                             [_D4_B, 1 - 2 * _D4_B, _D4_B], [1 - 2 * _D4_B, _D4_B, _D4_B]])
+DUNAVANT4_WEIGHTS = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
+
+
+def l2_corner_values(bank, nodes, xi, eta, sub, modes, quadratic):
+    """DP1 corner values per (mode, triangle, sub-triangle, corner): the L2
+    projection onto linear functions of v_n = phi . n (the triangle's own
+    quadratic interpolant and normal) over each flat sub-triangle, so that
+    each carries the interpolant's exact flux (a quadratic triangle's corner
+    shape functions integrate to zero; nodal sampling does not keep that).
+    On a flat sub-triangle with mass matrix (A/12)(I + J), the coefficients
+    are c_i = 12 b_i - 3 sum(b), b_i = mean over the triangle of lambda_i f."""
+    shape = quadratic_shape if quadratic else linear_shape
+    pos, phi_all = bank["positions"], bank["shapes"]
+    x = pos[nodes]  # (t, q, 3)
+    corners = np.stack([xi[sub], eta[sub]], axis=-1)  # (s, 3, 2): each sub-triangle's corners in (xi, eta)
+    qp = np.einsum("gc,scd->sgd", DUNAVANT4_POINTS, corners)  # (s, g, 2)
+    n, dxi, deta = shape(qp[..., 0].reshape(-1), qp[..., 1].reshape(-1))  # (q, s*g)
+    a = np.einsum("qp,tqc->tpc", dxi, x)
+    b = np.einsum("qp,tqc->tpc", deta, x)
+    normal = np.cross(a, b)
+    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+    phi = phi_all[modes][:, nodes]  # (m, t, q, 3)
+    f = np.einsum("qp,mtqc,tpc->mtp", n, phi, normal)  # (m, t, s*g)
+    f = f.reshape(len(modes), len(nodes), sub.shape[0], len(DUNAVANT4_WEIGHTS))
+    bary = np.einsum("g,gi,mtsg->mtsi", DUNAVANT4_WEIGHTS, DUNAVANT4_POINTS, f)  # (m, t, s, 3)
+    return 12 * bary - 3 * bary.sum(axis=-1, keepdims=True)
 
 
 class Solver:
@@ -236,7 +276,7 @@ def reference(args):
     import bempp_cl.api as bempp
     bempp.GLOBAL_PARAMETERS.quadrature.regular = args.quadrature
     t0 = time.time()
-    verts, elements, vn = refined_surface(bank, args.refine, modes)
+    verts, elements, vn = refined_surface(bank, args.refine, modes, args.velocity)
     solver = Solver(verts, elements)
     print(f"rad_ref: {len(modes)} mode(s), {len(elements)} triangles, {solver.p1.global_dof_count} P1 "
           f"and {solver.dp1.global_dof_count} DP1 unknowns", file=sys.stderr)
@@ -250,6 +290,7 @@ def reference(args):
         print(f"rad_ref: mode {m} at {f:.1f} Hz (k = {k:.2f} 1/m) solved in {time.time() - t1:.1f} s",
               file=sys.stderr)
         results.append({"index": m, "frequency_hz": f, "refine": args.refine, "quadrature": args.quadrature,
+                        "velocity": args.velocity,
                         "seconds": time.time() - t1, "pressure_pa": [[z.real, z.imag] for z in p]})
     report = {
         "generator": "tools/rad_ref.py (bempp-cl Galerkin P1/DP1 Burton-Miller)",
@@ -457,6 +498,9 @@ def main():
     ap.add_argument("--refine", type=int, default=1)
     ap.add_argument("--quadrature", type=int, default=4,
                     help="order of bempp's regular (non-adjacent) quadrature (bempp default 4)")
+    ap.add_argument("--velocity", choices=["nodes", "l2"], default="nodes",
+                    help="DP1 normal velocity: sampled at each flat triangle's corners (nodes), or the L2 "
+                         "projection of the quadratic interpolant onto each flat triangle (l2: keeps its flux)")
     ap.add_argument("--air-density", type=float, default=1.21)
     ap.add_argument("--sound-speed", type=float, default=343.0)
     ap.add_argument("-o", "--out")

@@ -49,8 +49,10 @@ pub mod near;
 pub mod normals;
 pub mod precond;
 pub mod quadrature;
+pub mod refine;
 mod sincos;
 pub mod special;
+mod velocity;
 
 pub use bem::{solve, solve_clustered, solve_on, Air, Discretization, Formulation, SolverPath, SurfaceField};
 pub use cluster::{Adjacency, Clusters};

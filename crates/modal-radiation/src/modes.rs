@@ -3,10 +3,11 @@
 //!
 //! Mass-normalized shapes `φ_i` [1/√kg] and modal velocity amplitude 1
 //! give the surface velocity `φ_i(x)` [m/s]; a panel's normal velocity is
-//! the mean of `φ · n` over its corners (all surface nodes: a quadratic
-//! surface triangle is four panels), `n` the smooth-surface normal at the
-//! node, fitted to the local surface ([`crate::normals`], [`normal_velocity`]). Modes whose frequencies lie within a relative
-//! `group_tolerance` of each other (degenerate pairs and multiplets) are
+//! the exact mean over the panel of its surface triangle's (quadratic or
+//! linear) interpolant of `φ · n` ([`crate::velocity`]; a quadratic surface
+//! triangle is four panels), `n` the smooth-surface normal at each node,
+//! fitted to the local surface ([`crate::normals`]). Modes whose
+//! frequencies lie within a relative `group_tolerance` of each other (degenerate pairs and multiplets) are
 //! solved at their geometric-mean frequency with one factorization: the
 //! transfer varies smoothly with `k` (no resonances in the exterior
 //! problem), by about `(l+1)·δf/f` in power for a degree-`l` multipole,
@@ -25,6 +26,7 @@ use crate::geometry::{dot, BoundaryMesh};
 use crate::multipole::{fit, Multipole, DEFAULT_TOLERANCE};
 use crate::near::NearField;
 use crate::normals::{fit_normals, SurfaceNormals};
+use crate::velocity::{panel_sources, triangle_source, velocity_of, PanelSource};
 
 /// Options of a bank radiation run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,9 +49,16 @@ pub struct RadiationOptions {
     /// Most bytes one solve's matrix and near field may hold
     /// ([`crate::bem::Discretization::memory_limit_bytes`]); `None`: no
     /// limit. The default solves stay below 1 GB (at most
-    /// [`MAX_DENSE_PANELS`] unknowns); a full-resolution one of 32 000
+    /// [`MAX_DENSE_PANELS`] unknowns); a full-resolution one of 64 000
     /// panels may need many GB at high frequency.
     pub memory_limit_bytes: Option<u64>,
+    /// With `adaptive_resolution` off: rounds of splitting the panels with
+    /// a corner on a crease (a thin wall's rim, a bar's edges) in four
+    /// ([`crate::refine`]). 0: none. On a free steel disc 20 cm × 2 mm the
+    /// 1 629 Hz mode moved by 0.43 dB median, 1.06 dB max after two rounds,
+    /// then 0.09 / 0.26 dB from one round to two (BENCHMARKS.md, "A thin
+    /// disc against bempp-cl").
+    pub crease_refinement: usize,
 }
 
 impl Default for RadiationOptions {
@@ -62,6 +71,7 @@ impl Default for RadiationOptions {
             adaptive_resolution: true,
             cluster_kh: DEFAULT_CLUSTER_KH,
             memory_limit_bytes: None,
+            crease_refinement: 0,
         }
     }
 }
@@ -209,39 +219,55 @@ pub fn corner_normals(bank: &ModeBank, mesh: &BoundaryMesh) -> Vec<[[f64; 3]; 3]
 }
 
 /// [`corner_normals`] from the bank's [`surface_normals`] `normals`.
-fn corner_normals_of(bank: &ModeBank, mesh: &BoundaryMesh, normals: &SurfaceNormals) -> Vec<[[f64; 3]; 3]> {
-    let s = &bank.surface;
-    let (split, per_triangle) = match &s.triangle_edge_nodes {
-        Some(_) => (&SPLIT_CORNERS[..], 4),
-        None => (&[[0, 1, 2]][..], 1),
-    };
-    // Node `k` of triangle `t` (corners, then mid-edge nodes).
-    let node_of = |t: usize, k: usize| match &s.triangle_edge_nodes {
-        Some(e) if k >= 3 => e[t][k - 3],
-        _ => s.triangles[t][k],
-    };
-    let from_triangles = mesh.panels.len() == per_triangle * s.triangles.len()
-        && mesh.panels.iter().enumerate().all(|(i, p)| {
-            let local = split[i % per_triangle];
-            (0..3).all(|j| p.corners[j] == node_of(i / per_triangle, local[j]))
-        });
+pub(crate) fn corner_normals_of(
+    bank: &ModeBank,
+    mesh: &BoundaryMesh,
+    normals: &SurfaceNormals,
+) -> Vec<[[f64; 3]; 3]> {
+    let split = split_of(bank, mesh);
     mesh.panels
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let smooth: [[f64; 3]; 3] = if from_triangles {
-                split[i % per_triangle].map(|k| normals.per_triangle[i / per_triangle][k])
-            } else {
-                p.corners.map(|c| normals.per_node.get(c).copied().unwrap_or([0.0; 3]))
+            let smooth: [[f64; 3]; 3] = match split {
+                Some(split) => split[i % split.len()].map(|k| normals.per_triangle[i / split.len()][k]),
+                None => p.corners.map(|c| normals.per_node.get(c).copied().unwrap_or([0.0; 3])),
             };
             smooth.map(|n| smooth_or_panel(n, p.normal))
         })
         .collect()
 }
 
+/// How `mesh`'s panels lie on the bank's triangles: `Some(split)` when
+/// `mesh` is the bank's [`boundary_mesh`], whose panel `i` has the local
+/// nodes `split[i % split.len()]` of triangle `i / split.len()` (see
+/// [`triangle_node`]); `None` for any other panel mesh.
+pub(crate) fn split_of(bank: &ModeBank, mesh: &BoundaryMesh) -> Option<&'static [[usize; 3]]> {
+    let s = &bank.surface;
+    let split: &'static [[usize; 3]] = match &s.triangle_edge_nodes {
+        Some(_) => &SPLIT_CORNERS,
+        None => &[[0, 1, 2]],
+    };
+    let matches = mesh.panels.len() == split.len() * s.triangles.len()
+        && mesh.panels.iter().enumerate().all(|(i, p)| {
+            let local = split[i % split.len()];
+            (0..3).all(|j| p.corners[j] == triangle_node(bank, i / split.len(), local[j]))
+        });
+    matches.then_some(split)
+}
+
+/// Surface node `k` of bank triangle `t`: corners 0–2, then (quadratic
+/// banks) the mid-edge nodes of edges 01, 12, 20.
+pub(crate) fn triangle_node(bank: &ModeBank, t: usize, k: usize) -> usize {
+    match &bank.surface.triangle_edge_nodes {
+        Some(e) if k >= 3 => e[t][k - 3],
+        _ => bank.surface.triangles[t][k],
+    }
+}
+
 /// The node's normal where it is within [`CREASE_ANGLE_DEG`] of the panel
 /// normal, else the panel normal.
-fn smooth_or_panel(node: [f64; 3], panel: [f64; 3]) -> [f64; 3] {
+pub(crate) fn smooth_or_panel(node: [f64; 3], panel: [f64; 3]) -> [f64; 3] {
     let cos_crease = CREASE_ANGLE_DEG.to_radians().cos();
     if node != [0.0; 3] && dot(node, panel) >= cos_crease {
         node
@@ -251,47 +277,23 @@ fn smooth_or_panel(node: [f64; 3], panel: [f64; 3]) -> [f64; 3] {
 }
 
 /// Normal velocity of mode `mode` on each panel at unit modal velocity
-/// [m/s]: the mean over the panel's corners of `φ · n` with the corner
-/// normals of [`corner_normals`] (so a purely tangential motion of a
-/// curved surface, like a sphere's torsional modes, gives ≈ 0 rather than
-/// the facets' tilt).
+/// [m/s], as the solver takes it: on the bank's [`boundary_mesh`], the
+/// exact mean over the panel of its triangle's interpolant of `φ · n`
+/// ([`crate::velocity`]), on any other panel mesh over the bank's nodes
+/// the mean over its corners, with the normals of [`corner_normals`] (so
+/// a purely tangential motion of a curved surface, like a sphere's
+/// torsional modes, gives ≈ 0 rather than the facets' tilt).
 pub fn normal_velocity(
     bank: &ModeBank,
     mesh: &BoundaryMesh,
     mode: usize,
 ) -> Result<Vec<c64>, RadiationError> {
-    normal_velocity_with(bank, mesh, &corner_normals(bank, mesh), mode)
-}
-
-fn normal_velocity_with(
-    bank: &ModeBank,
-    mesh: &BoundaryMesh,
-    normals: &[[[f64; 3]; 3]],
-    mode: usize,
-) -> Result<Vec<c64>, RadiationError> {
-    if mode >= bank.mode_count() {
-        return Err(RadiationError::NoSuchMode { mode, count: bank.mode_count() });
-    }
     if mesh.vertices.len() != bank.surface_node_count() {
         return Err(RadiationError::Bank("the panel mesh is not the bank's surface".into()));
     }
-    Ok(mesh
-        .panels
-        .iter()
-        .zip(normals)
-        .map(|(p, n)| {
-            let v: f64 = p
-                .corners
-                .iter()
-                .zip(n)
-                .map(|(&c, n)| {
-                    let s = bank.shape_at(mode, c);
-                    dot([s[0] as f64, s[1] as f64, s[2] as f64], *n)
-                })
-                .sum();
-            c64::new(v / 3.0, 0.0)
-        })
-        .collect())
+    let sources = panel_sources(bank, mesh, &surface_normals(bank));
+    let weights: Vec<[f64; 6]> = sources.iter().map(PanelSource::weights).collect();
+    velocity_of(bank, &sources, &weights, mode)
 }
 
 /// Lowest damped frequency treated as audible [Hz].
@@ -379,10 +381,11 @@ pub const MAX_DENSE_PANELS: usize = crate::bem::MAX_DENSE_UNKNOWNS;
 /// above [`MAX_DENSE_PANELS`], without the dense fallback (a GMRES that does
 /// not converge there is an error, [`RadiationError::NotConverged`]). A thin
 /// wall needs unknowns about a wall thickness wide: a free disc 20 cm × 2 mm
-/// on its 31 360-panel split took 13–16 s a mode and 1.5 GB below 2 kHz, and
-/// agreed with bempp-cl where the default did not (BENCHMARKS.md, "A thin disc
-/// against bempp-cl").
-pub const MAX_FULL_RESOLUTION_PANELS: usize = 32_000;
+/// on its 31 360-panel split took 13–46 s a mode and 1.5 GB below 2 kHz; with
+/// two rounds of [`RadiationOptions::crease_refinement`], 47 488 panels, 65 s
+/// and 2.3 GB at 1.6 kHz (BENCHMARKS.md, "A thin disc against bempp-cl").
+/// Larger solves are stopped by the memory guard as their assembly crosses it.
+pub const MAX_FULL_RESOLUTION_PANELS: usize = 64_000;
 
 /// One panel level of a bank: panels, their adjacency, their near field
 /// (integrated when the level is first solved on), and how to get a mode's
@@ -393,44 +396,29 @@ struct Level {
     near: std::sync::OnceLock<NearField>,
     /// Longest panel edge [m].
     h: f64,
-    /// Per panel, its three corners' taps: the velocity is the mean over the
-    /// corners of `φ·n`, each corner the mean of its two (node, normal)
-    /// taps (the same node twice at a surface node, an edge's two ends at
-    /// a midpoint of the [`Panels::finer`] level).
-    taps: Vec<[Corner; 3]>,
+    /// Per panel, where its velocity comes from ([`crate::velocity`]).
+    sources: Vec<PanelSource>,
+    /// Per panel, [`PanelSource::weights`].
+    weights: Vec<[f64; 6]>,
 }
 
-/// A panel corner's two (surface node, normal) taps (see [`Level::taps`]).
-type Corner = [(usize, [f64; 3]); 2];
-
 impl Level {
-    fn new(mesh: BoundaryMesh, taps: Vec<[Corner; 3]>) -> Level {
+    fn new(mesh: BoundaryMesh, sources: Vec<PanelSource>) -> Level {
+        debug_assert_eq!(mesh.len(), sources.len());
         Level {
             h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
             adjacency: Adjacency::new(&mesh),
             near: std::sync::OnceLock::new(),
             mesh: Arc::new(mesh),
-            taps,
+            weights: sources.iter().map(PanelSource::weights).collect(),
+            sources,
         }
     }
 
+    /// Mode `mode`'s normal velocity on each panel: the exact mean over the
+    /// panel of its triangle's interpolant of `φ·n` ([`crate::velocity`]).
     fn velocity(&self, bank: &ModeBank, mode: usize) -> Result<Vec<c64>, RadiationError> {
-        if mode >= bank.mode_count() {
-            return Err(RadiationError::NoSuchMode { mode, count: bank.mode_count() });
-        }
-        Ok(self
-            .taps
-            .iter()
-            .map(|taps| {
-                let tap = |(c, n): (usize, [f64; 3])| {
-                    let s = bank.shape_at(mode, c);
-                    dot([s[0] as f64, s[1] as f64, s[2] as f64], n)
-                };
-                // (x + x)·½ = x exactly: a node's corner gives its own value.
-                let v: f64 = taps.iter().map(|&[a, b]| (tap(a) + tap(b)) * 0.5).sum();
-                c64::new(v / 3.0, 0.0)
-            })
-            .collect())
+        velocity_of(bank, &self.sources, &self.weights, mode)
     }
 }
 
@@ -441,8 +429,8 @@ impl Level {
 struct Panels {
     fine: Level,
     coarse: Option<Level>,
-    /// Each fine panel split in four at its edge midpoints (velocity
-    /// linear along each edge), when that still has at most
+    /// Each fine panel split in four at its edge midpoints (velocity: the
+    /// exact mean of the triangle's interpolant over each quarter), when that still has at most
     /// [`MAX_DENSE_PANELS`] panels: small objects whose fine panels are
     /// too coarse for their top modes (`k·h > 1`) get one unknown per
     /// panel at half the size (see [`plan`]). `None` when the split does
@@ -450,6 +438,9 @@ struct Panels {
     /// [`Panels::finer`] when a frequency group first needs it, so a run
     /// of low modes never splits.
     finer: Option<std::sync::OnceLock<Level>>,
+    /// The fine level refined towards its creases
+    /// ([`RadiationOptions::crease_refinement`] rounds), made on first use.
+    refined: std::sync::OnceLock<Level>,
 }
 
 impl Panels {
@@ -458,28 +449,25 @@ impl Panels {
             return Err(RadiationError::Bank("the panel mesh is not the bank's surface".into()));
         }
         let smooth = surface_normals(bank);
-        let normals = corner_normals_of(bank, mesh, &smooth);
-        let taps: Vec<[Corner; 3]> = mesh
-            .panels
-            .iter()
-            .zip(&normals)
-            .map(|(p, n)| [0, 1, 2].map(|k| [(p.corners[k], n[k]); 2]))
-            .collect();
+        let sources = panel_sources(bank, mesh, &smooth);
         let corners = if adaptive { corner_mesh(bank)? } else { None };
-        let coarse = corners.zip(bank.surface.triangle_edge_nodes.as_ref()).map(|(m, edges)| {
-            let taps = m
+        // The corner triangles: each a whole quadratic triangle, whose mean
+        // is the mean of its mid-edge values.
+        let coarse = corners.map(|m| {
+            let sources = m
                 .panels
                 .iter()
-                .zip(edges)
                 .zip(&smooth.per_triangle)
-                .map(|((p, e), n)| [0, 1, 2].map(|k| [(e[k], smooth_or_panel(n[3 + k], p.normal)); 2]))
+                .enumerate()
+                .map(|(t, (p, n))| triangle_source(bank, t, n, p.normal, true))
                 .collect();
-            Level::new(m, taps)
+            Level::new(m, sources)
         });
         Ok(Panels {
-            fine: Level::new(mesh.clone(), taps),
+            fine: Level::new(mesh.clone(), sources),
             coarse,
             finer: (adaptive && 4 * mesh.len() <= MAX_DENSE_PANELS).then(std::sync::OnceLock::new),
+            refined: std::sync::OnceLock::new(),
         })
     }
 
@@ -489,36 +477,40 @@ impl Panels {
         if let Some(level) = cell.get() {
             return Ok(Some(level));
         }
-        let level = split_level(&self.fine.mesh, &self.fine.taps)?;
+        let level = split_level(&self.fine.mesh, &self.fine.sources)?;
         Ok(Some(cell.get_or_init(|| level)))
+    }
+
+    /// The fine level with the panels at its creases split `rounds` times
+    /// ([`crate::refine::refine_near_creases`]); `None` for 0 rounds.
+    fn refined(&self, rounds: usize) -> Result<Option<&Level>, RadiationError> {
+        if rounds == 0 {
+            return Ok(None);
+        }
+        if let Some(level) = self.refined.get() {
+            return Ok(Some(level));
+        }
+        let (mesh, sources) = crate::refine::refine_near_creases(
+            &self.fine.mesh,
+            &self.fine.sources,
+            rounds,
+            CREASE_ANGLE_DEG,
+            PanelSource::quarters,
+        )?;
+        let level = Level::new(mesh, sources);
+        Ok(Some(self.refined.get_or_init(|| level)))
     }
 }
 
-/// The [`Panels::finer`] level of `mesh` with taps `taps`: each panel
-/// `[a, b, c]` split at its edge midpoints (shared between neighbours, so
-/// the surface stays closed) into `[a, ab, ca]`, `[ab, b, bc]`,
-/// `[ca, bc, c]`, `[ab, bc, ca]`; a midpoint's taps are its edge's ends.
-fn split_level(mesh: &BoundaryMesh, taps: &[[Corner; 3]]) -> Result<Level, RadiationError> {
-    let mut vertices = mesh.vertices.clone();
-    let mut midpoints: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
-    let mut midpoint = |a: usize, b: usize, vertices: &mut Vec<[f64; 3]>| {
-        *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
-            let (va, vb) = (vertices[a], vertices[b]);
-            vertices.push([0, 1, 2].map(|k| 0.5 * (va[k] + vb[k])));
-            vertices.len() - 1
-        })
-    };
-    let (mut triangles, mut split_taps) =
-        (Vec::with_capacity(4 * mesh.len()), Vec::with_capacity(4 * mesh.len()));
-    for (panel, t) in mesh.panels.iter().zip(taps) {
-        let [a, b, c] = panel.corners;
-        let [ab, bc, ca] = [(a, b), (b, c), (c, a)].map(|(u, v)| midpoint(u, v, &mut vertices));
-        let [ta, tb, tc] = t.map(|corner| corner[0]);
-        let (tab, tbc, tca) = ([ta, tb], [tb, tc], [tc, ta]);
-        triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-        split_taps.extend([[[ta; 2], tab, tca], [tab, [tb; 2], tbc], [tca, tbc, [tc; 2]], [tab, tbc, tca]]);
-    }
-    Ok(Level::new(BoundaryMesh::new(vertices, &triangles)?, split_taps))
+/// The [`Panels::finer`] level of `mesh` whose panels take their velocity
+/// from `sources`: each panel `[a, b, c]` split at its edge midpoints
+/// (shared between neighbours, so the surface stays closed) into
+/// `[a, ab, ca]`, `[ab, b, bc]`, `[ca, bc, c]`, `[ab, bc, ca]`, each
+/// quarter the exact mean of its triangle's interpolant over it
+/// ([`PanelSource::quarters`]).
+fn split_level(mesh: &BoundaryMesh, sources: &[PanelSource]) -> Result<Level, RadiationError> {
+    let (mesh, sources) = crate::refine::split_panels(mesh, sources, |_| true, PanelSource::quarters)?;
+    Ok(Level::new(mesh, sources))
 }
 
 /// How one frequency group was solved.
@@ -544,6 +536,10 @@ fn plan<'a>(
         _ => &panels.fine,
     };
     if !opts.adaptive_resolution {
+        let level = match panels.refined(opts.crease_refinement)? {
+            Some(refined) => refined,
+            None => level,
+        };
         if level.mesh.len() > MAX_FULL_RESOLUTION_PANELS {
             let max = MAX_FULL_RESOLUTION_PANELS;
             return Err(RadiationError::TooManyPanels { panels: level.mesh.len(), max });
@@ -721,34 +717,38 @@ mod tests {
 
     /// The finer level of a closed surface is closed (inside point still
     /// inside), has four times the panels, `V + E` vertices and the same
-    /// area, and its taps keep every panel's integral of a velocity that is
-    /// linear over each parent panel (`Σ` children's area × mean of their
-    /// corners = the parent's).
+    /// area, and keeps every panel's integral of a velocity that is linear
+    /// over each parent panel (`Σ` children's area × velocity = the
+    /// parent's).
     #[test]
     fn the_finer_level_splits_each_panel_in_four_and_keeps_the_velocity_integral() {
         let mesh = crate::geometry::tests::icosphere(0.1, [0.01, -0.02, 0.03], 2);
         let n = mesh.len();
-        let taps: Vec<[Corner; 3]> =
-            mesh.panels.iter().map(|p| [0, 1, 2].map(|k| [(p.corners[k], p.normal); 2])).collect();
-        let finer = split_level(&mesh, &taps).expect("a closed surface splits");
+        let sources: Vec<PanelSource> =
+            mesh.panels.iter().map(|p| PanelSource::linear(p.corners.map(|c| (c, p.normal)))).collect();
+        let finer = split_level(&mesh, &sources).expect("a closed surface splits");
         assert_eq!(finer.mesh.len(), 4 * n);
         assert_eq!(finer.mesh.vertices.len(), mesh.vertices.len() + 3 * n / 2);
         assert!((finer.mesh.area() - mesh.area()).abs() <= 1e-12 * mesh.area());
         assert!(finer.mesh.contains([0.01, -0.02, 0.03]) && !finer.mesh.contains([0.2, 0.0, 0.0]));
         assert!(2.0 * finer.h <= mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max) + 1e-15);
 
-        // A nodal value f(node) = a smooth function; per panel, the mean of
-        // its corners' tap means (Level::velocity without the bank).
+        // A nodal value f(node) = a smooth function; per panel, its
+        // weighted nodal values (Level::velocity without the bank).
         let f = |node: usize| {
             let v = mesh.vertices[node];
             3.0 * v[0] - v[1] * v[2] + 0.5
         };
-        let value = |t: &[Corner; 3]| t.iter().map(|&[a, b]| (f(a.0) + f(b.0)) * 0.5).sum::<f64>() / 3.0;
-        for (parent, (p, t)) in mesh.panels.iter().zip(&taps).enumerate() {
-            let children = &finer.taps[4 * parent..4 * parent + 4];
-            let split: f64 =
-                children.iter().zip(&finer.mesh.panels[4 * parent..]).map(|(c, q)| q.area * value(c)).sum();
-            let whole = p.area * value(t);
+        let value = |s: &PanelSource, w: &[f64; 6]| (0..3).map(|k| w[k] * f(s.nodes[k].0)).sum::<f64>();
+        for (parent, (p, s)) in mesh.panels.iter().zip(&sources).enumerate() {
+            let children = 4 * parent..4 * parent + 4;
+            let split: f64 = finer.sources[children.clone()]
+                .iter()
+                .zip(&finer.weights[children.clone()])
+                .zip(&finer.mesh.panels[children])
+                .map(|((c, w), q)| q.area * value(c, w))
+                .sum();
+            let whole = p.area * value(s, &s.weights());
             assert!(
                 (split - whole).abs() <= 1e-12 * whole.abs().max(p.area),
                 "panel {parent}: {split} vs {whole}"
