@@ -53,6 +53,7 @@ pub mod refine;
 mod sincos;
 pub mod special;
 mod velocity;
+pub mod walls;
 
 pub use bem::{solve, solve_clustered, solve_on, Air, Discretization, Formulation, SolverPath, SurfaceField};
 pub use cluster::{Adjacency, Clusters};
