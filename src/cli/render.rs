@@ -304,8 +304,9 @@ impl PipelineProvider<'_> {
                 // 1 < k·h ≤ 2; v6: default pressure clusters κ = 0.3 (was 0.5); v7: compressed
                 // (H-matrix, ACA) assembly from 4 000 unknowns; v13: kernel points
                 // evaluated in SIMD lanes (levels within 0.0001 dB, other bits); v14:
-                // compressed assembly from 2 000 unknowns.
-                let key = CacheKey::new("modal-radiation-v14")
+                // compressed assembly from 2 000 unknowns; v15: each panel the exact mean of
+                // its triangle's interpolated velocity (modal_radiation::velocity).
+                let key = CacheKey::new("modal-radiation-v15")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)
