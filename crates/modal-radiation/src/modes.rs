@@ -7,11 +7,11 @@
 //! linear) interpolant of `φ · n` ([`crate::velocity`]; a quadratic surface
 //! triangle is four panels), `n` the smooth-surface normal at each node,
 //! fitted to the local surface ([`crate::normals`]). Modes whose
-//! frequencies lie within a relative `group_tolerance` of each other (degenerate pairs and multiplets) are
-//! solved at their geometric-mean frequency with one factorization: the
-//! transfer varies smoothly with `k` (no resonances in the exterior
-//! problem), by about `(l+1)·δf/f` in power for a degree-`l` multipole,
-//! i.e. < 0.04 dB at the default 10⁻³.
+//! frequencies lie within a relative `group_tolerance` of each other
+//! (degenerate pairs and multiplets) are solved at their geometric-mean
+//! frequency with one factorization: the transfer varies smoothly with `k`
+//! (no resonances in the exterior problem), by about `(l+1)·δf/f` in power
+//! for a degree-`l` multipole, i.e. < 0.04 dB at the default 10⁻³.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -56,8 +56,8 @@ pub struct RadiationOptions {
     /// a corner on a crease (a thin wall's rim, a bar's edges) in four
     /// ([`crate::refine`]). 0: none. On a free steel disc 20 cm × 2 mm the
     /// 1 629 Hz mode moved by 0.43 dB median, 1.06 dB max after two rounds,
-    /// then 0.09 / 0.26 dB from one round to two (BENCHMARKS.md, "A thin
-    /// disc against bempp-cl").
+    /// and by 0.09 / 0.26 dB from one round to two (BENCHMARKS.md, "The
+    /// thin disc again").
     pub crease_refinement: usize,
 }
 
@@ -382,8 +382,9 @@ pub const MAX_DENSE_PANELS: usize = crate::bem::MAX_DENSE_UNKNOWNS;
 /// not converge there is an error, [`RadiationError::NotConverged`]). A thin
 /// wall needs unknowns about a wall thickness wide: a free disc 20 cm × 2 mm
 /// on its 31 360-panel split took 13–46 s a mode and 1.5 GB below 2 kHz; with
-/// two rounds of [`RadiationOptions::crease_refinement`], 47 488 panels, 65 s
-/// and 2.3 GB at 1.6 kHz (BENCHMARKS.md, "A thin disc against bempp-cl").
+/// two rounds of [`RadiationOptions::crease_refinement`], 47 488 panels,
+/// 65–96 s a mode and 2.3 GB at 1.6 kHz (BENCHMARKS.md, "The thin disc
+/// again").
 /// Larger solves are stopped by the memory guard as their assembly crosses it.
 pub const MAX_FULL_RESOLUTION_PANELS: usize = 64_000;
 

@@ -16,9 +16,9 @@
 //! to zero: the flux is `(A/3) Σ` of its mid-edge values). The former rule,
 //! the mean of the panel's corner values, did not: on a free thin disc
 //! (20 cm × 2 mm) it gave mode 3's net broadside flux `Σ v_n n_z A` as
-//! 1.36× the interpolant's, and the axis of an `n`-diameter mode, silent
-//! but for that flux, is where the levels of the two solvers disagreed
-//! (BENCHMARKS.md, "A thin disc against bempp-cl").
+//! 1.36× the interpolant's, and along the axis of such an `n`-diameter
+//! mode that small flux is all that is heard (BENCHMARKS.md, "The thin
+//! disc again").
 
 use faer::c64;
 use modal_bank::ModeBank;
@@ -84,11 +84,11 @@ impl PanelSource {
     }
 }
 
-/// Where each panel of `mesh` takes its velocity from
-/// (this module): on the bank's [`crate::modes::boundary_mesh`], its place on
-/// its bank triangle, each of the triangle's nodes with its smooth normal
-/// where that is within [`crate::modes::CREASE_ANGLE_DEG`] of the panel's; on any other
-/// panel mesh over the bank's nodes, its corners with their
+/// Where each panel of `mesh` takes its velocity from: on the bank's
+/// [`crate::modes::boundary_mesh`], its place on its bank triangle, each of
+/// the triangle's nodes with its smooth normal where that is within
+/// [`crate::modes::CREASE_ANGLE_DEG`] of the panel's; on any other panel
+/// mesh over the bank's nodes, its corners with their
 /// [`crate::modes::corner_normals`], the velocity linear between them.
 pub(crate) fn panel_sources(
     bank: &ModeBank,
