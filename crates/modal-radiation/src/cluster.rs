@@ -25,7 +25,7 @@
 //! mean of `(∇v·ê)²` over edge directions is `|∇v|²/2`; a plane wave
 //! `cos(k_s x)` gives `k_s`).
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
 
 use faer::c64;
 
@@ -127,13 +127,7 @@ impl Adjacency {
     /// Neighbours through shared corner pairs (edges).
     pub fn new(mesh: &BoundaryMesh) -> Adjacency {
         let n = mesh.len();
-        let mut edges: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-        for (i, p) in mesh.panels.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (p.corners[k], p.corners[(k + 1) % 3]);
-                edges.entry((a.min(b), a.max(b))).or_default().push(i);
-            }
-        }
+        let edges = mesh.edge_panels();
         let mut nbr: Vec<Vec<usize>> = vec![Vec::new(); n];
         for (i, p) in mesh.panels.iter().enumerate() {
             for k in 0..3 {

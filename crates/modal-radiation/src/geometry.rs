@@ -17,6 +17,8 @@
 //! inside the triangle (barycentric coordinates `λᵢ = n·((xⱼ−x′)×(xₖ−x′))/|n|²
 //! ≥ 0`), else the nearest point of the nearest edge segment.
 
+use std::collections::HashMap;
+
 use crate::error::RadiationError;
 
 /// One flat triangular panel.
@@ -188,6 +190,19 @@ impl BoundaryMesh {
             .flat_map(|(&[a, b, c], &[ab, bc, ca])| [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]])
             .collect();
         Self::new(vertices, &split)
+    }
+
+    /// The panels on each edge, an edge keyed by its two corner indices,
+    /// smaller first (two on a closed manifold surface).
+    pub fn edge_panels(&self) -> HashMap<(usize, usize), Vec<usize>> {
+        let mut edges: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+        for (i, p) in self.panels.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (p.corners[k], p.corners[(k + 1) % 3]);
+                edges.entry((a.min(b), a.max(b))).or_default().push(i);
+            }
+        }
+        edges
     }
 
     /// Number of panels (unknowns of the solve).

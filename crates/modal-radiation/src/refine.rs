@@ -71,14 +71,7 @@ fn split_with_midpoints<T: Copy>(
 /// more than `crease_deg` between their normals.
 pub fn crease_edges(mesh: &BoundaryMesh, crease_deg: f64) -> HashSet<(usize, usize)> {
     let cos_crease = crease_deg.to_radians().cos();
-    let mut by_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (i, p) in mesh.panels.iter().enumerate() {
-        let [a, b, c] = p.corners;
-        for (u, v) in [(a, b), (b, c), (c, a)] {
-            by_edge.entry((u.min(v), u.max(v))).or_default().push(i);
-        }
-    }
-    by_edge
+    mesh.edge_panels()
         .into_iter()
         .filter(|(_, ps)| {
             ps.iter()
