@@ -776,4 +776,12 @@ fn a_thin_disc_is_warned_about_at_the_default_resolution() {
     let full = ["radiation", "d.bank", "--mode", "0", "--full-resolution"];
     let refused = modal_within_memory(dir.path(), &full, "0.001").fails_with("memory limit");
     assert!(!refused.stderr.contains("thin wall"), "{}", refused.stderr);
+    // Three rounds at its rim take the disc past the full-resolution limit
+    // (68 992 panels): refused before any solve, and the advice is fewer
+    // rounds, not dropping --full-resolution (which the refinement needs).
+    let mut refined = full.to_vec();
+    refined.extend(["--refine-creases", "3"]);
+    let over = modal(dir.path(), &refined).fails_with("round(s) of crease refinement make");
+    assert!(over.stderr.contains("fewer --refine-creases rounds"), "{}", over.stderr);
+    assert!(!over.stderr.contains("drop --full-resolution"), "{}", over.stderr);
 }

@@ -160,6 +160,19 @@ pub enum RadiationError {
         /// The limit.
         max: usize,
     },
+    /// Refining the creases made more panels than a full-resolution solve takes.
+    #[error(
+        "{rounds} round(s) of crease refinement make {panels} panels, more than the {max} unknowns a \
+         full-resolution solve takes: use fewer --refine-creases rounds"
+    )]
+    TooManyRefinedPanels {
+        /// Panels after the refinement.
+        panels: usize,
+        /// The limit.
+        max: usize,
+        /// Rounds of refinement asked for.
+        rounds: usize,
+    },
     /// A mode index is out of range.
     #[error("mode {mode} does not exist (the bank has {count})")]
     NoSuchMode {

@@ -537,13 +537,13 @@ fn plan<'a>(
         _ => &panels.fine,
     };
     if !opts.adaptive_resolution {
-        let level = match panels.refined(opts.crease_refinement)? {
-            Some(refined) => refined,
-            None => level,
-        };
-        if level.mesh.len() > MAX_FULL_RESOLUTION_PANELS {
-            let max = MAX_FULL_RESOLUTION_PANELS;
+        let (max, rounds) = (MAX_FULL_RESOLUTION_PANELS, opts.crease_refinement);
+        if level.mesh.len() > max {
             return Err(RadiationError::TooManyPanels { panels: level.mesh.len(), max });
+        }
+        let level = panels.refined(rounds)?.unwrap_or(level);
+        if level.mesh.len() > max {
+            return Err(RadiationError::TooManyRefinedPanels { panels: level.mesh.len(), max, rounds });
         }
         let clusters = Clusters::identity(level.mesh.len());
         return Ok(Plan { level, clusters, under_resolved: k * level.h > UNDER_RESOLVED_KH, k_eff });
