@@ -131,6 +131,19 @@ pub enum RadiationError {
         /// The dense solve's limit.
         max: usize,
     },
+    /// The surface turns too sharply between neighbouring panels for its
+    /// pressure to be grouped into few enough unknowns.
+    #[error(
+        "at {frequency_hz:.0} Hz the surface cannot be grouped into {max} pressure unknowns: its neighbouring \
+         panels turn too sharply (a rough or spiky mesh); --full-resolution solves it with one unknown per panel, \
+         or smooth the mesh"
+    )]
+    TooRuggedToCluster {
+        /// Frequency [Hz].
+        frequency_hz: f64,
+        /// Most unknowns of a clustered solve.
+        max: usize,
+    },
     /// The system would hold more memory than the guard allows
     /// ([`crate::modes::RadiationOptions::memory_limit_bytes`]).
     #[error(

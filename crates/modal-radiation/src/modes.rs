@@ -135,6 +135,12 @@ pub struct Progress {
     /// the clusters had to grow to fit [`MAX_DENSE_PANELS`]. Expect larger
     /// errors; mesh finer for such modes.
     pub under_resolved: bool,
+    /// The cluster size `κ` (`k_eff` × diameter) the clusters had to grow
+    /// to, past the one asked for, to fit [`MAX_DENSE_PANELS`] unknowns
+    /// (`None`: they did not). κ = 0.5 was 0.19 / 0.71 dB (median / max) and
+    /// κ = 1 0.63 / 1.0 dB from one unknown per panel on the demo bar
+    /// (BENCHMARKS.md, "Error against cost").
+    pub grown_kh: Option<f64>,
     /// Seconds spent in the solve (near field when first needed, assembly,
     /// GMRES or LU).
     pub solve_s: f64,
@@ -160,7 +166,13 @@ impl std::fmt::Display for Progress {
             self.frequency_hz,
             self.unknowns,
             self.panels,
-            if self.under_resolved { " (under-resolved: expect larger errors)" } else { "" },
+            match (self.grown_kh, self.under_resolved) {
+                (Some(kh), _) => format!(
+                    " (under-resolved: clusters grown to κ = {kh:.2} to fit {MAX_DENSE_PANELS} unknowns, expect larger errors)"
+                ),
+                (None, true) => " (under-resolved: expect larger errors)".to_string(),
+                (None, false) => String::new(),
+            },
             self.solve_s,
             if self.near_s > 0.0 {
                 format!(" (near field {:.2} s, {:.0} MB)", self.near_s, self.near_bytes as f64 / 1e6)
@@ -519,6 +531,9 @@ struct Plan<'a> {
     level: &'a Level,
     clusters: Clusters,
     under_resolved: bool,
+    /// `κ` the clusters grew to past the one asked for, to fit
+    /// [`MAX_DENSE_PANELS`] unknowns.
+    grown_kh: Option<f64>,
     /// Effective wavenumber max(k, k_s) [1/m].
     k_eff: f64,
 }
@@ -546,19 +561,48 @@ fn plan<'a>(
             return Err(RadiationError::TooManyRefinedPanels { panels: level.mesh.len(), max, rounds });
         }
         let clusters = Clusters::identity(level.mesh.len());
-        return Ok(Plan { level, clusters, under_resolved: k * level.h > UNDER_RESOLVED_KH, k_eff });
+        let under_resolved = k * level.h > UNDER_RESOLVED_KH;
+        return Ok(Plan { level, clusters, under_resolved, grown_kh: None, k_eff });
     }
-    let mut diameter = (opts.cluster_kh / k_eff).min(MAX_CLUSTER_RADIUS_FRACTION * radius);
-    let mut clusters = Clusters::grow(&level.mesh, &level.adjacency, diameter);
-    let mut forced = false;
-    while clusters.len() > MAX_DENSE_PANELS {
-        diameter *= 1.25;
-        forced = true;
-        clusters = Clusters::grow(&level.mesh, &level.adjacency, diameter);
+    let wanted = (opts.cluster_kh / k_eff).min(MAX_CLUSTER_RADIUS_FRACTION * radius);
+    let (clusters, diameter) =
+        fit_clusters(&level.mesh, &level.adjacency, wanted, 4.0 * radius, MAX_DENSE_PANELS).ok_or_else(
+            || {
+                let frequency_hz = k * opts.air.sound_speed_m_s / std::f64::consts::TAU;
+                RadiationError::TooRuggedToCluster { frequency_hz, max: MAX_DENSE_PANELS }
+            },
+        )?;
+    let grown_kh = (diameter > wanted).then_some(k_eff * diameter);
+    let under_resolved = grown_kh.is_some()
+        || k * diameter.max(level.h) > UNDER_RESOLVED_KH && k * level.h > UNDER_RESOLVED_KH;
+    Ok(Plan { level, clusters, under_resolved, grown_kh, k_eff })
+}
+
+/// Clusters of `mesh` of diameter `wanted` [m], grown by 1.25× at a time
+/// until at most `max` remain, and the diameter they took; `None` when even
+/// clusters reaching across the body (`largest` [m]) are too many. Growth stops
+/// there because a cluster never spans panels whose normals turn by more
+/// than [`crate::cluster::MAX_NORMAL_ANGLE_DEG`] from its seed's: on a rough
+/// or spiky surface that, not the diameter, bounds the clusters, and
+/// growing forever would hang the run.
+fn fit_clusters(
+    mesh: &BoundaryMesh,
+    adjacency: &Adjacency,
+    wanted: f64,
+    largest: f64,
+    max: usize,
+) -> Option<(Clusters, f64)> {
+    let mut diameter = wanted;
+    loop {
+        let clusters = Clusters::grow(mesh, adjacency, diameter);
+        if clusters.len() <= max {
+            return Some((clusters, diameter));
+        }
+        if diameter >= largest {
+            return None;
+        }
+        diameter = (1.25 * diameter).min(largest);
     }
-    let under_resolved =
-        forced || k * diameter.max(level.h) > UNDER_RESOLVED_KH && k * level.h > UNDER_RESOLVED_KH;
-    Ok(Plan { level, clusters, under_resolved, k_eff })
 }
 
 /// [`radiate_modes`] on a given panel mesh of the bank's surface.
@@ -628,6 +672,7 @@ pub fn radiate_modes_on(
             unknowns: plan.clusters.len(),
             k_eff: plan.k_eff,
             under_resolved: plan.under_resolved,
+            grown_kh: plan.grown_kh,
             solve_s,
             near_s,
             near_bytes: near.bytes(),
@@ -715,6 +760,24 @@ pub fn stored_multipole(table: &modal_bank::RadiationTable, entry: &modal_bank::
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An icosahedron's neighbouring faces turn by 41.8°, more than a
+    /// cluster spans: no diameter groups its 20 faces into fewer than 20
+    /// clusters, so asking for 10 ends (`None`, the run's error) instead of
+    /// growing for ever; an icosphere's gentler faces group as asked, and a
+    /// cap they already fit keeps the diameter asked for.
+    #[test]
+    fn clusters_stop_growing_where_the_normals_bound_them() {
+        let ico = crate::geometry::tests::icosphere(0.1, [0.0; 3], 0);
+        assert_eq!(ico.len(), 20);
+        assert!(fit_clusters(&ico, &Adjacency::new(&ico), 0.01, 0.4, 10).is_none());
+        let fine = crate::geometry::tests::icosphere(0.1, [0.0; 3], 3);
+        let adjacency = Adjacency::new(&fine);
+        let (clusters, diameter) = fit_clusters(&fine, &adjacency, 0.01, 0.4, 200).expect("it groups");
+        assert!(clusters.len() <= 200 && diameter > 0.01 && diameter <= 0.4, "{} {diameter}", clusters.len());
+        let (all, kept) = fit_clusters(&fine, &adjacency, 0.01, 0.4, fine.len()).expect("it fits");
+        assert_eq!((all.len() <= fine.len(), kept), (true, 0.01));
+    }
 
     /// The finer level of a closed surface is closed (inside point still
     /// inside), has four times the panels, `V + E` vertices and the same
