@@ -148,8 +148,8 @@ pub enum RadiationError {
     /// ([`crate::modes::RadiationOptions::memory_limit_bytes`]).
     #[error(
         "the boundary-element system at {frequency_hz:.0} Hz ({unknowns} unknowns) needs more than the memory \
-         limit of {:.2} GB (MODAL_MEMORY_LIMIT_GB, or 75 % of the available memory): drop --full-resolution, \
-         or solve the lower modes only (--max-freq)",
+         limit of {:.2} GB (MODAL_MEMORY_LIMIT_GB, or 75 % of the available memory): solve the lower modes \
+         only (--max-freq), drop --full-resolution if it was given, or free memory",
         *limit_bytes as f64 / 1e9
     )]
     OutOfMemory {
