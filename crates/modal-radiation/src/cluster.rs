@@ -64,6 +64,33 @@ impl Clusters {
         self.collocation.len() == self.of_panel.len()
     }
 
+    /// Clusters of diameter `wanted` [m], grown by 1.25× at a time until at
+    /// most `max` remain, and the diameter they took; `None` when even
+    /// clusters reaching across the body (`largest` [m]) are too many.
+    /// Growth stops there because a cluster never spans panels whose normals
+    /// turn by more than [`MAX_NORMAL_ANGLE_DEG`] from its seed's: on a rough
+    /// or spiky surface that, not the diameter, bounds the clusters, and
+    /// growing for ever would hang the run.
+    pub fn fit(
+        mesh: &BoundaryMesh,
+        adjacency: &Adjacency,
+        wanted: f64,
+        largest: f64,
+        max: usize,
+    ) -> Option<(Clusters, f64)> {
+        let mut diameter = wanted;
+        loop {
+            let clusters = Clusters::grow(mesh, adjacency, diameter);
+            if clusters.len() <= max {
+                return Some((clusters, diameter));
+            }
+            if diameter >= largest {
+                return None;
+            }
+            diameter = (1.25 * diameter).min(largest);
+        }
+    }
+
     /// Clusters of diameter about `diameter` [m] (see the module doc); a
     /// diameter below the panels' gives one panel per cluster.
     pub fn grow(mesh: &BoundaryMesh, adjacency: &Adjacency, diameter: f64) -> Clusters {
@@ -234,6 +261,24 @@ mod tests {
         let total: f64 = area.iter().sum();
         assert!((total - mesh.area()).abs() < 1e-12 * total);
         assert_eq!(c, Clusters::grow(&mesh, &adj, 0.4), "deterministic");
+    }
+
+    /// An icosahedron's neighbouring faces turn by 41.8°, more than a
+    /// cluster spans: no diameter groups its 20 faces into fewer than 20
+    /// clusters, so asking for 10 ends (`None`, the run's error) instead of
+    /// growing for ever; a finer sphere's gentler faces group as asked, and
+    /// a cap they already fit keeps the diameter asked for.
+    #[test]
+    fn clusters_stop_growing_where_the_normals_bound_them() {
+        let ico = sphere(0);
+        assert_eq!(ico.len(), 20);
+        assert!(Clusters::fit(&ico, &Adjacency::new(&ico), 0.1, 4.0, 10).is_none());
+        let fine = sphere(3);
+        let adjacency = Adjacency::new(&fine);
+        let (clusters, diameter) = Clusters::fit(&fine, &adjacency, 0.1, 4.0, 200).expect("it groups");
+        assert!(clusters.len() <= 200 && diameter > 0.1 && diameter <= 4.0, "{} {diameter}", clusters.len());
+        let (all, kept) = Clusters::fit(&fine, &adjacency, 0.1, 4.0, fine.len()).expect("it fits");
+        assert_eq!((all.len() <= fine.len(), kept), (true, 0.1));
     }
 
     #[test]

@@ -566,7 +566,7 @@ fn plan<'a>(
     }
     let wanted = (opts.cluster_kh / k_eff).min(MAX_CLUSTER_RADIUS_FRACTION * radius);
     let (clusters, diameter) =
-        fit_clusters(&level.mesh, &level.adjacency, wanted, 4.0 * radius, MAX_DENSE_PANELS).ok_or_else(
+        Clusters::fit(&level.mesh, &level.adjacency, wanted, 4.0 * radius, MAX_DENSE_PANELS).ok_or_else(
             || {
                 let frequency_hz = k * opts.air.sound_speed_m_s / std::f64::consts::TAU;
                 RadiationError::TooRuggedToCluster { frequency_hz, max: MAX_DENSE_PANELS }
@@ -576,33 +576,6 @@ fn plan<'a>(
     let under_resolved = grown_kh.is_some()
         || k * diameter.max(level.h) > UNDER_RESOLVED_KH && k * level.h > UNDER_RESOLVED_KH;
     Ok(Plan { level, clusters, under_resolved, grown_kh, k_eff })
-}
-
-/// Clusters of `mesh` of diameter `wanted` [m], grown by 1.25× at a time
-/// until at most `max` remain, and the diameter they took; `None` when even
-/// clusters reaching across the body (`largest` [m]) are too many. Growth stops
-/// there because a cluster never spans panels whose normals turn by more
-/// than [`crate::cluster::MAX_NORMAL_ANGLE_DEG`] from its seed's: on a rough
-/// or spiky surface that, not the diameter, bounds the clusters, and
-/// growing forever would hang the run.
-fn fit_clusters(
-    mesh: &BoundaryMesh,
-    adjacency: &Adjacency,
-    wanted: f64,
-    largest: f64,
-    max: usize,
-) -> Option<(Clusters, f64)> {
-    let mut diameter = wanted;
-    loop {
-        let clusters = Clusters::grow(mesh, adjacency, diameter);
-        if clusters.len() <= max {
-            return Some((clusters, diameter));
-        }
-        if diameter >= largest {
-            return None;
-        }
-        diameter = (1.25 * diameter).min(largest);
-    }
 }
 
 /// [`radiate_modes`] on a given panel mesh of the bank's surface.
@@ -760,24 +733,6 @@ pub fn stored_multipole(table: &modal_bank::RadiationTable, entry: &modal_bank::
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// An icosahedron's neighbouring faces turn by 41.8°, more than a
-    /// cluster spans: no diameter groups its 20 faces into fewer than 20
-    /// clusters, so asking for 10 ends (`None`, the run's error) instead of
-    /// growing for ever; an icosphere's gentler faces group as asked, and a
-    /// cap they already fit keeps the diameter asked for.
-    #[test]
-    fn clusters_stop_growing_where_the_normals_bound_them() {
-        let ico = crate::geometry::tests::icosphere(0.1, [0.0; 3], 0);
-        assert_eq!(ico.len(), 20);
-        assert!(fit_clusters(&ico, &Adjacency::new(&ico), 0.01, 0.4, 10).is_none());
-        let fine = crate::geometry::tests::icosphere(0.1, [0.0; 3], 3);
-        let adjacency = Adjacency::new(&fine);
-        let (clusters, diameter) = fit_clusters(&fine, &adjacency, 0.01, 0.4, 200).expect("it groups");
-        assert!(clusters.len() <= 200 && diameter > 0.01 && diameter <= 0.4, "{} {diameter}", clusters.len());
-        let (all, kept) = fit_clusters(&fine, &adjacency, 0.01, 0.4, fine.len()).expect("it fits");
-        assert_eq!((all.len() <= fine.len(), kept), (true, 0.01));
-    }
 
     /// The finer level of a closed surface is closed (inside point still
     /// inside), has four times the panels, `V + E` vertices and the same
