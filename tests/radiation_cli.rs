@@ -473,6 +473,23 @@ fn strike_hears_the_listener_by_default_linearly_and_audibly() {
         "solved {} vs stored {peak}",
         solved["peak"]
     );
+    // --transfer-max-freq caps the solve: above every mode it is the whole
+    // solve, below every mode it is the estimate, sample for sample.
+    let capped =
+        |hz: &str, out: &str| strike("sphere.bank", &["--solve-radiation", "--transfer-max-freq", hz], out);
+    assert_eq!(capped("1e9", "all.wav").json()["peak"], solved["peak"]);
+    let none = capped("1", "none.wav");
+    assert!(none.stderr.contains("keep the level estimate"), "{}", none.stderr);
+    assert_eq!(none.json()["peak"], est.json()["peak"]);
+    assert_eq!(
+        std::fs::read(dir.path().join("none.wav")).unwrap(),
+        std::fs::read(dir.path().join("est.wav")).unwrap()
+    );
+    let bare = ["strike", "sphere.bank", "--at", "0.05,0,0", "--transfer-max-freq", "5000", "-o", "b.wav"];
+    assert!(!modal(dir.path(), &bare).success, "--transfer-max-freq needs --solve-radiation");
+    let mut negative = vec!["strike", "sphere.bank", "--at", "0.05,0,0", "--solve-radiation", "-o", "b.wav"];
+    negative.extend(["--transfer-max-freq", "-5"]);
+    modal(dir.path(), &negative).fails_with("--transfer-max-freq must be a positive frequency");
     // The contact microphone stays available; a listener inside the body is an error.
     assert_eq!(strike("rad.bank", &["--mic", "0.05,0,0"], "mic.wav").json()["output"]["kind"], "contact_mic");
     modal(dir.path(), &["strike", "rad.bank", "--at", "0.05,0,0", "--listener", "0,0,0.01", "-o", "x.wav"])

@@ -389,6 +389,10 @@ pub struct StrikeArgs {
     /// Solve the radiation now when the bank has none stored (slow; see `modal radiation --store`).
     #[arg(long, conflicts_with = "mic")]
     pub solve_radiation: bool,
+    /// With --solve-radiation: solve only the modes up to HZ; those above keep the level estimate
+    /// (said on stderr), as `render --transfer-max-freq` (default: every audible mode).
+    #[arg(long, value_name = "HZ", requires = "solve_radiation", allow_negative_numbers = true)]
+    pub transfer_max_freq: Option<f64>,
     /// Duration [s], at least one sample and at most 3600; it ends with a 5 ms fade (default: until
     /// the sound decayed by 60 dB, at most 30 s after the last strike).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]

@@ -119,7 +119,7 @@ pub fn listener_gains(
     bank: &ModeBank,
     table: Option<&RadiationTable>,
     x: [f64; 3],
-    solve: bool,
+    solve_up_to_hz: Option<f64>,
     sample_rate_hz: f64,
 ) -> Result<ListenerGains> {
     let mesh = modal_radiation::modes::boundary_mesh(bank).context("the bank's surface cannot be used")?;
@@ -129,7 +129,7 @@ pub fn listener_gains(
         let (f, d, xi) = (bank.frequencies_hz[i], bank.decay_rates[i], bank.damping_ratios[i]);
         modal_synth::classify_mode(f, d, xi, sample_rate_hz).is_ok()
     });
-    if let Some(table) = table.filter(|_| !solve) {
+    if let Some(table) = table.filter(|_| solve_up_to_hz.is_none()) {
         let estimate = estimate_gains(bank, x)?;
         let direction_free = modal_synth::degenerate_phases(&bank.frequencies_hz);
         let mut heard = Heard::new(bank.mode_count());
@@ -164,18 +164,34 @@ pub fn listener_gains(
         }
         return Ok(heard.from(TransferSource::Stored));
     }
-    if solve {
+    if let Some(max_hz) = solve_up_to_hz {
+        let (solved, above): (Vec<usize>, Vec<usize>) =
+            audible.iter().partition(|&&i| bank.frequencies_hz[i] <= max_hz);
         let opts = RadiationOptions {
             air: Air::default(),
             memory_limit_bytes: super::precompute::memory_guard_bytes()?,
             ..RadiationOptions::default()
         };
         let started = std::time::Instant::now();
-        let results = modal_radiation::modes::radiate_modes_on(bank, &mesh, &audible, &opts, &mut |p| {
-            eprintln!("{p}")
-        })?;
+        let results = if solved.is_empty() {
+            Vec::new()
+        } else {
+            modal_radiation::modes::radiate_modes_on(bank, &mesh, &solved, &opts, &mut |p| eprintln!("{p}"))?
+        };
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
         let mut heard = Heard::new(bank.mode_count());
+        if !above.is_empty() {
+            warn(&format!(
+                "{} audible mode(s) above --transfer-max-freq {max_hz} Hz keep the level estimate",
+                above.len()
+            ));
+            let (estimate, direction_free) =
+                (estimate_gains(bank, x)?, modal_synth::degenerate_phases(&bank.frequencies_hz));
+            for i in above {
+                heard.gains[i] = estimate[i];
+                heard.phases[i] = direction_free[i];
+            }
+        }
         for r in &results {
             let r_ref = distance(x, r.multipole.centre);
             heard.set(r.mode, r.pressure_at(x)?, r.multipole.wavenumber * r_ref);
