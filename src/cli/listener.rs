@@ -167,6 +167,12 @@ pub fn listener_gains(
     if let Some(max_hz) = solve_up_to_hz {
         let (solved, above): (Vec<usize>, Vec<usize>) =
             audible.iter().partition(|&&i| bank.frequencies_hz[i] <= max_hz);
+        if !above.is_empty() {
+            warn(&format!(
+                "{} audible mode(s) above --transfer-max-freq {max_hz} Hz keep the level estimate",
+                above.len()
+            ));
+        }
         let opts = RadiationOptions {
             air: Air::default(),
             memory_limit_bytes: super::precompute::memory_guard_bytes()?,
@@ -181,10 +187,6 @@ pub fn listener_gains(
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
         let mut heard = Heard::new(bank.mode_count());
         if !above.is_empty() {
-            warn(&format!(
-                "{} audible mode(s) above --transfer-max-freq {max_hz} Hz keep the level estimate",
-                above.len()
-            ));
             let (estimate, direction_free) =
                 (estimate_gains(bank, x)?, modal_synth::degenerate_phases(&bank.frequencies_hz));
             for i in above {
