@@ -48,10 +48,13 @@ pub fn thin_walls(mesh: &BoundaryMesh) -> ThinWalls {
         }
     }
     let thin_area: f64 = thin.iter().map(|x| x.0).sum();
+    let median = |value: fn(&(f64, f64, f64)) -> f64| {
+        modal_mesh::weighted_median(&mut thin.iter().map(|x| (value(x), x.0)).collect::<Vec<_>>())
+    };
     ThinWalls {
         area_fraction: if total > 0.0 { thin_area / total } else { 0.0 },
-        median_wall_m: weighted_median(thin.iter().map(|x| (x.0, x.1)).collect()),
-        median_panel_m: weighted_median(thin.iter().map(|x| (x.0, x.2)).collect()),
+        median_wall_m: median(|x| x.1),
+        median_panel_m: median(|x| x.2),
     }
 }
 
@@ -89,20 +92,6 @@ fn ray_hits_triangle(origin: [f64; 3], dir: [f64; 3], tri: [[f64; 3]; 3]) -> Opt
         return None;
     }
     Some(dot(e2, qv) / det)
-}
-
-/// The value at half the total weight of `(weight, value)` pairs; 0 if none.
-fn weighted_median(mut pairs: Vec<(f64, f64)>) -> f64 {
-    pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
-    let half = 0.5 * pairs.iter().map(|p| p.0).sum::<f64>();
-    let mut acc = 0.0;
-    for (w, v) in &pairs {
-        acc += w;
-        if acc >= half {
-            return *v;
-        }
-    }
-    0.0
 }
 
 #[cfg(test)]

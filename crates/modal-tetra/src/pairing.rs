@@ -301,14 +301,5 @@ fn manifold_neighbours<'a>(
 fn median_wall(pairs: &[Pair]) -> f64 {
     let mut walls: Vec<(f64, f64)> =
         pairs.iter().filter(|p| p.partner.is_some()).map(|p| (p.thickness, p.area)).collect();
-    walls.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let half = 0.5 * walls.iter().map(|w| w.1).sum::<f64>();
-    let mut acc = 0.0;
-    for (t, a) in &walls {
-        acc += a;
-        if acc >= half {
-            return *t;
-        }
-    }
-    walls.last().map_or(0.0, |w| w.0)
+    modal_mesh::weighted_median(&mut walls)
 }
