@@ -130,8 +130,7 @@ pub fn listener_gains(
         modal_synth::classify_mode(f, d, xi, sample_rate_hz).is_ok()
     });
     if let Some(table) = table.filter(|_| solve_up_to_hz.is_none()) {
-        let estimate = estimate_gains(bank, x)?;
-        let direction_free = modal_synth::degenerate_phases(&bank.frequencies_hz);
+        let estimated = estimate(bank, x)?;
         let mut heard = Heard::new(bank.mode_count());
         let mut missing = 0;
         let r = distance(x, table.centre_m);
@@ -153,8 +152,7 @@ pub fn listener_gains(
                     heard.set(i, held_pressure(&mp, x), mp.wavenumber * r_ref);
                 }
                 None => {
-                    heard.gains[i] = estimate[i];
-                    heard.phases[i] = direction_free[i];
+                    heard.estimated(i, &estimated);
                     missing += 1;
                 }
             }
@@ -187,11 +185,9 @@ pub fn listener_gains(
         eprintln!("radiation: {} mode(s) solved in {:.2} s", results.len(), started.elapsed().as_secs_f64());
         let mut heard = Heard::new(bank.mode_count());
         if !above.is_empty() {
-            let (estimate, direction_free) =
-                (estimate_gains(bank, x)?, modal_synth::degenerate_phases(&bank.frequencies_hz));
+            let estimated = estimate(bank, x)?;
             for i in above {
-                heard.gains[i] = estimate[i];
-                heard.phases[i] = direction_free[i];
+                heard.estimated(i, &estimated);
             }
         }
         for r in &results {
@@ -205,6 +201,12 @@ pub fn listener_gains(
          (run `modal radiation BANK --store OUT.bank`, or strike with --solve-radiation)",
         path.display()
     ));
+    estimate(bank, x)
+}
+
+/// The pulsating-sphere estimate at `x` for every mode, with the phases of
+/// modes heard without a transfer ([`modal_synth::degenerate_phases`]).
+fn estimate(bank: &ModeBank, x: [f64; 3]) -> Result<ListenerGains> {
     let gains = estimate_gains(bank, x)?;
     let phases = modal_synth::degenerate_phases(&bank.frequencies_hz);
     Ok(ListenerGains { gains, phases, source: TransferSource::Estimate })
@@ -232,6 +234,12 @@ impl Heard {
             let reduced = c64::new(t.re, -t.im) * c64::new(c, s) / level;
             self.phases[i] = C64::new(reduced.re, reduced.im);
         }
+    }
+
+    /// Mode `i` heard through the level `estimate` (no transfer for it).
+    fn estimated(&mut self, i: usize, estimate: &ListenerGains) {
+        self.gains[i] = estimate.gains[i];
+        self.phases[i] = estimate.phases[i];
     }
 
     fn from(self, source: TransferSource) -> ListenerGains {
