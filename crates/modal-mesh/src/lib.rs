@@ -27,6 +27,7 @@
 //! file position, element or node; nothing here panics on user data.
 
 mod closest;
+mod disc;
 mod disjoint;
 mod error;
 mod icosphere;
@@ -46,6 +47,7 @@ pub mod generate;
 pub mod io;
 
 pub use closest::closest_point_on_triangle;
+pub use disc::disc_surface;
 pub use disjoint::DisjointSets;
 pub use error::{Location, MeshError};
 pub use icosphere::icosphere;

@@ -10,40 +10,11 @@ use modal_radiation::refine::refine_near_creases;
 use modal_radiation::{solve, Air, BoundaryMesh, Formulation};
 
 /// A closed disc of radius `a` and thickness `t` about the origin: `rings`
-/// rings of `segments` on each face and one band of quads around the rim.
+/// rings of `segments = 6·rings` nodes on each face and one band of quads
+/// around the rim ([`modal_mesh::disc_surface`]).
 fn disc(a: f64, t: f64, rings: usize, segments: usize) -> BoundaryMesh {
-    let mut v = Vec::new();
-    let mut tris = Vec::new();
-    let mut face = |z: f64, up: bool, v: &mut Vec<[f64; 3]>| -> Vec<usize> {
-        let centre = v.len();
-        v.push([0.0, 0.0, z]);
-        let at = |r: usize, s: usize| centre + 1 + (r - 1) * segments + s % segments;
-        for r in 1..=rings {
-            let rho = a * r as f64 / rings as f64;
-            for s in 0..segments {
-                let phi = 2.0 * std::f64::consts::PI * (s as f64 + 0.5 * (r % 2) as f64) / segments as f64;
-                v.push([rho * phi.cos(), rho * phi.sin(), z]);
-            }
-        }
-        let mut push = |a: usize, b: usize, c: usize| tris.push(if up { [a, b, c] } else { [a, c, b] });
-        for s in 0..segments {
-            push(centre, at(1, s), at(1, s + 1));
-        }
-        for r in 1..rings {
-            for s in 0..segments {
-                push(at(r, s), at(r + 1, s), at(r + 1, s + 1));
-                push(at(r, s), at(r + 1, s + 1), at(r, s + 1));
-            }
-        }
-        (0..segments).map(|s| at(rings, s)).collect()
-    };
-    let top = face(0.5 * t, true, &mut v);
-    let bottom = face(-0.5 * t, false, &mut v);
-    for s in 0..segments {
-        let (a0, a1, b0, b1) = (top[s], top[(s + 1) % segments], bottom[s], bottom[(s + 1) % segments]);
-        tris.push([b0, a1, a0]);
-        tris.push([b0, b1, a1]);
-    }
+    assert_eq!(segments, 6 * rings);
+    let (v, tris) = modal_mesh::disc_surface(a, t, rings);
     BoundaryMesh::new(v, &tris).unwrap()
 }
 
