@@ -37,14 +37,13 @@ pub struct ThinWalls {
 /// [`ThinWalls`] of `mesh` (a closed, outward surface).
 pub fn thin_walls(mesh: &BoundaryMesh) -> ThinWalls {
     let stride = mesh.len().div_ceil(MAX_RAYS).max(1);
+    let mut rays = WallRays::new(mesh);
     let (mut total, mut thin) = (0.0, Vec::new());
     for i in (0..mesh.len()).step_by(stride) {
         let p = &mesh.panels[i];
         total += p.area;
-        if let Some(t) = wall_at(mesh, i) {
-            if t < THIN_WALL_RATIO * p.diameter {
-                thin.push((p.area, t, p.diameter));
-            }
+        if let Some((_, t)) = rays.across(i, THIN_WALL_RATIO * p.diameter) {
+            thin.push((p.area, t, p.diameter));
         }
     }
     let thin_area: f64 = thin.iter().map(|x| x.0).sum();
@@ -58,18 +57,139 @@ pub fn thin_walls(mesh: &BoundaryMesh) -> ThinWalls {
     }
 }
 
-/// The wall at panel `i`: distance along `−n` from its centroid to the
-/// nearest opposite-facing panel the ray crosses; `None` if it crosses none.
-fn wall_at(mesh: &BoundaryMesh, i: usize) -> Option<f64> {
-    let p = &mesh.panels[i];
-    let dir = p.normal.map(|x| -x);
-    mesh.panels
-        .iter()
-        .enumerate()
-        .filter(|&(j, q)| j != i && dot(q.normal, p.normal) < -0.5)
-        .filter_map(|(_, q)| ray_hits_triangle(p.centroid, dir, q.corners.map(|c| mesh.vertices[c])))
-        .filter(|&t| t > 0.0)
-        .reduce(f64::min)
+/// The other face of a thin wall under each panel: for panel `i`, the
+/// opposite-facing panel first crossed by the ray along `−n` from its
+/// centroid, if it lies closer than `max_ratio` times the panel's diameter
+/// ([`WallRays::across`]).
+pub fn opposite_panels(mesh: &BoundaryMesh, max_ratio: f64) -> Vec<Option<usize>> {
+    let mut rays = WallRays::new(mesh);
+    (0..mesh.len()).map(|i| rays.across(i, max_ratio * mesh.panels[i].diameter).map(|(j, _)| j)).collect()
+}
+
+/// Rays into the body from panel centroids, against the panels bucketed in
+/// a uniform grid of the median panel diameter: each short ray tests the
+/// few panels near it, `O(N)` for a surface of similar panels (a test of
+/// every panel per ray cost 1.13 s for 2 000 rays on a 64 656-panel goblet).
+pub struct WallRays<'a> {
+    mesh: &'a BoundaryMesh,
+    grid: PanelGrid,
+    stamp: Vec<usize>,
+    candidates: Vec<usize>,
+}
+
+impl<'a> WallRays<'a> {
+    /// The grid of `mesh`'s panels.
+    pub fn new(mesh: &'a BoundaryMesh) -> WallRays<'a> {
+        WallRays {
+            mesh,
+            grid: PanelGrid::new(mesh),
+            stamp: vec![usize::MAX; mesh.len()],
+            candidates: Vec::new(),
+        }
+    }
+
+    /// The wall under panel `i`: the nearest panel facing the other way
+    /// (`n·n' < −½`, the wall's other face) that the ray along `−n` from the
+    /// centroid crosses within `reach` [m], and the distance to it.
+    pub fn across(&mut self, i: usize, reach: f64) -> Option<(usize, f64)> {
+        let mesh = self.mesh;
+        let p = &mesh.panels[i];
+        let dir = p.normal.map(|x| -x);
+        let end = [0, 1, 2].map(|k| p.centroid[k] + reach * dir[k]);
+        self.candidates.clear();
+        self.grid.panels_near_segment(p.centroid, end, i, &mut self.stamp, &mut self.candidates);
+        self.candidates
+            .iter()
+            .filter(|&&j| dot(mesh.panels[j].normal, p.normal) < -0.5)
+            .filter_map(|&j| {
+                let tri = mesh.panels[j].corners.map(|c| mesh.vertices[c]);
+                ray_hits_triangle(p.centroid, dir, tri).filter(|&t| t > 0.0 && t < reach).map(|t| (j, t))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+    }
+}
+
+/// Panels bucketed by the grid cells their bounding boxes touch.
+struct PanelGrid {
+    origin: [f64; 3],
+    cell: f64,
+    dims: [usize; 3],
+    start: Vec<usize>,
+    list: Vec<usize>,
+}
+
+impl PanelGrid {
+    fn new(mesh: &BoundaryMesh) -> PanelGrid {
+        let mut diameters: Vec<(f64, f64)> = mesh.panels.iter().map(|p| (p.diameter, 1.0)).collect();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for v in &mesh.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        let span = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        // At most ~64³ cells: a median below span/64 only lengthens the lists.
+        let cell = modal_mesh::weighted_median(&mut diameters).max(span / 64.0);
+        let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell) as usize + 1).min(1 << 16));
+        let cell_of = |x: f64, k: usize| (((x - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1);
+        let mut buckets: Vec<Vec<usize>> = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
+        for (j, p) in mesh.panels.iter().enumerate() {
+            let corners = p.corners.map(|c| mesh.vertices[c]);
+            let range = |k: usize| {
+                let (a, b) = corners
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| (a.min(c[k]), b.max(c[k])));
+                cell_of(a, k)..=cell_of(b, k)
+            };
+            for x in range(0) {
+                for y in range(1) {
+                    for z in range(2) {
+                        buckets[(x * dims[1] + y) * dims[2] + z].push(j);
+                    }
+                }
+            }
+        }
+        let mut start = Vec::with_capacity(buckets.len() + 1);
+        let mut list = Vec::new();
+        for b in &buckets {
+            start.push(list.len());
+            list.extend_from_slice(b);
+        }
+        start.push(list.len());
+        PanelGrid { origin: lo, cell, dims, start, list }
+    }
+
+    /// Appends to `out` each panel (other than `skip`) bucketed in a cell
+    /// of the segment `a`–`b`'s bounding box, once (`stamp` marks the
+    /// panels seen for `skip`).
+    fn panels_near_segment(
+        &self,
+        a: [f64; 3],
+        b: [f64; 3],
+        skip: usize,
+        stamp: &mut [usize],
+        out: &mut Vec<usize>,
+    ) {
+        let cell_of = |x: f64, k: usize| {
+            (((x - self.origin[k]) / self.cell).floor().max(0.0) as usize).min(self.dims[k] - 1)
+        };
+        let range = |k: usize| cell_of(a[k].min(b[k]), k)..=cell_of(a[k].max(b[k]), k);
+        for x in range(0) {
+            for y in range(1) {
+                for z in range(2) {
+                    let c = (x * self.dims[1] + y) * self.dims[2] + z;
+                    for &j in &self.list[self.start[c]..self.start[c + 1]] {
+                        if j != skip && stamp[j] != skip {
+                            stamp[j] = skip;
+                            out.push(j);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Distance along the unit `dir` from `origin` at which the ray crosses
@@ -129,6 +249,34 @@ mod tests {
             }
         }
         BoundaryMesh::new(v, &tris).unwrap()
+    }
+
+    /// The grid finds what a test of every panel finds: on a hollow ball
+    /// (a wall 0.05 thick between spheres of radius 1 and 0.95) every
+    /// panel's nearest opposite-facing crossing within 0.2, and none within
+    /// 0.04.
+    #[test]
+    fn wall_rays_find_what_a_test_of_every_panel_finds() {
+        let (v, t) = modal_mesh::icosphere(3);
+        let mut vertices: Vec<[f64; 3]> = v.clone();
+        vertices.extend(v.iter().map(|p| p.map(|x| 0.95 * x)));
+        let mut triangles = t.clone();
+        triangles.extend(t.iter().map(|&[a, b, c]| [a + v.len(), c + v.len(), b + v.len()]));
+        let mesh = BoundaryMesh::new(vertices, &triangles).unwrap();
+        let mut rays = WallRays::new(&mesh);
+        for (i, p) in mesh.panels.iter().enumerate() {
+            let dir = p.normal.map(|x| -x);
+            let brute = (0..mesh.len())
+                .filter(|&j| j != i && dot(mesh.panels[j].normal, p.normal) < -0.5)
+                .filter_map(|j| {
+                    let tri = mesh.panels[j].corners.map(|c| mesh.vertices[c]);
+                    ray_hits_triangle(p.centroid, dir, tri).filter(|&t| t > 0.0 && t < 0.2).map(|t| (j, t))
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            assert!(brute.is_some(), "panel {i} sees no wall");
+            assert_eq!(rays.across(i, 0.2), brute, "panel {i}");
+            assert_eq!(rays.across(i, 0.04), None, "panel {i}");
+        }
     }
 
     /// A plate 2 mm thick on 14 mm panels is thin over its faces (about
