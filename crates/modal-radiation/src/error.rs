@@ -173,6 +173,14 @@ pub enum RadiationError {
         /// The limit.
         max: usize,
     },
+    /// A screen has more interior nodes than one dense screen solve takes.
+    #[error("the screen has {unknowns} interior nodes, more than the {max} of one dense screen solve")]
+    ScreenTooLarge {
+        /// Interior nodes (unknowns) of the screen.
+        unknowns: usize,
+        /// The limit ([`crate::screen::MAX_SCREEN_UNKNOWNS`]).
+        max: usize,
+    },
     /// Refining the creases made more panels than a full-resolution solve takes.
     #[error(
         "{rounds} round(s) of crease refinement make {panels} panels, more than the {max} unknowns a \

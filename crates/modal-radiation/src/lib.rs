@@ -25,6 +25,8 @@
 //! - [`precond`]: the block-Jacobi preconditioner of the GMRES solves;
 //! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
+//! - [`screen`]: an open screen's pressure jump by Galerkin (the thin-wall probe; not used by the solves);
+//! - [`walls`]: how much of a surface is a wall thinner than its panels;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
 //!
 //! The reference sphere surface of the tests is `modal_mesh::icosphere`.
@@ -50,6 +52,7 @@ pub mod normals;
 pub mod precond;
 pub mod quadrature;
 pub mod refine;
+pub mod screen;
 mod sincos;
 pub mod special;
 mod velocity;
