@@ -73,7 +73,10 @@ pub fn opposite_panels(mesh: &BoundaryMesh, max_ratio: f64) -> Vec<Option<usize>
 pub struct WallRays<'a> {
     mesh: &'a BoundaryMesh,
     grid: PanelGrid,
-    stamp: Vec<usize>,
+    /// Per panel, the last query that listed it (so each query lists a
+    /// panel once, and a query never sees an earlier one's marks).
+    stamp: Vec<u64>,
+    query: u64,
     candidates: Vec<usize>,
 }
 
@@ -83,7 +86,8 @@ impl<'a> WallRays<'a> {
         WallRays {
             mesh,
             grid: PanelGrid::new(mesh),
-            stamp: vec![usize::MAX; mesh.len()],
+            stamp: vec![0; mesh.len()],
+            query: 0,
             candidates: Vec::new(),
         }
     }
@@ -97,7 +101,14 @@ impl<'a> WallRays<'a> {
         let dir = p.normal.map(|x| -x);
         let end = [0, 1, 2].map(|k| p.centroid[k] + reach * dir[k]);
         self.candidates.clear();
-        self.grid.panels_near_segment(p.centroid, end, i, &mut self.stamp, &mut self.candidates);
+        self.query += 1;
+        self.grid.panels_near_segment(
+            p.centroid,
+            end,
+            i,
+            (&mut self.stamp, self.query),
+            &mut self.candidates,
+        );
         self.candidates
             .iter()
             .filter(|&&j| dot(mesh.panels[j].normal, p.normal) < -0.5)
@@ -162,14 +173,14 @@ impl PanelGrid {
     }
 
     /// Appends to `out` each panel (other than `skip`) bucketed in a cell
-    /// of the segment `a`–`b`'s bounding box, once (`stamp` marks the
-    /// panels seen for `skip`).
+    /// of the segment `a`–`b`'s bounding box, once (`stamp[j] = query`
+    /// marks the panels this query has listed).
     fn panels_near_segment(
         &self,
         a: [f64; 3],
         b: [f64; 3],
         skip: usize,
-        stamp: &mut [usize],
+        (stamp, query): (&mut [u64], u64),
         out: &mut Vec<usize>,
     ) {
         let cell_of = |x: f64, k: usize| {
@@ -181,8 +192,8 @@ impl PanelGrid {
                 for z in range(2) {
                     let c = (x * self.dims[1] + y) * self.dims[2] + z;
                     for &j in &self.list[self.start[c]..self.start[c + 1]] {
-                        if j != skip && stamp[j] != skip {
-                            stamp[j] = skip;
+                        if j != skip && stamp[j] != query {
+                            stamp[j] = query;
                             out.push(j);
                         }
                     }
@@ -253,8 +264,8 @@ mod tests {
 
     /// The grid finds what a test of every panel finds: on a hollow ball
     /// (a wall 0.05 thick between spheres of radius 1 and 0.95) every
-    /// panel's nearest opposite-facing crossing within 0.2, and none within
-    /// 0.04.
+    /// panel's nearest opposite-facing crossing within 0.2, none within
+    /// 0.04, and the same again when asked again.
     #[test]
     fn wall_rays_find_what_a_test_of_every_panel_finds() {
         let (v, t) = modal_mesh::icosphere(3);
@@ -276,6 +287,7 @@ mod tests {
             assert!(brute.is_some(), "panel {i} sees no wall");
             assert_eq!(rays.across(i, 0.2), brute, "panel {i}");
             assert_eq!(rays.across(i, 0.04), None, "panel {i}");
+            assert_eq!(rays.across(i, 0.2), brute, "panel {i} asked again");
         }
     }
 
