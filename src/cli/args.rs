@@ -290,6 +290,17 @@ impl Default for Accuracy {
     }
 }
 
+/// `--transfer-max-freq` (precompute, render, strike) when given: a finite, positive frequency.
+pub fn check_transfer_max_freq(hz: Option<f64>) -> anyhow::Result<()> {
+    if let Some(f) = hz {
+        anyhow::ensure!(
+            f.is_finite() && f > 0.0,
+            "--transfer-max-freq must be a positive frequency in Hz, got {f}"
+        );
+    }
+    Ok(())
+}
+
 fn parse_accuracy(s: &str) -> Result<Accuracy, String> {
     if s.eq_ignore_ascii_case("off") {
         return Ok(Accuracy(None));

@@ -118,12 +118,7 @@ pub fn run(args: PrecomputeArgs) -> Result<()> {
         .accuracy
         .0
         .map(|target_pct| modal_precompute::AccuracyTarget { target_pct, modes: args.accuracy_modes });
-    if let Some(f) = args.transfer_max_freq {
-        anyhow::ensure!(
-            f.is_finite() && f > 0.0,
-            "--transfer-max-freq must be a positive frequency in Hz, got {f}"
-        );
-    }
+    super::args::check_transfer_max_freq(args.transfer_max_freq)?;
     let cache = open_cache(args.cache_dir.as_deref(), args.no_cache)?;
     openable("precompute", &args.mesh)?;
     super::prepare_output(&args.out).with_context(|| format!("cannot write bank {}", args.out.display()))?;

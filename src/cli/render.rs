@@ -519,9 +519,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         None => (Scene::demo(), PathBuf::from(DEMO_OUTPUT)),
     };
-    if let Some(f) = args.transfer_max_freq {
-        anyhow::ensure!(f.is_finite() && f > 0.0, "--transfer-max-freq must be a positive frequency [Hz]");
-    }
+    super::args::check_transfer_max_freq(args.transfer_max_freq)?;
     let mut scene = scene;
     match args.radiation {
         Some(RadiationChoice::Estimate) => scene.listener.radiation = modal_scene::Radiation::Estimate,

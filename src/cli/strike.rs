@@ -125,9 +125,7 @@ fn contact_time(args: &StrikeArgs, bank: &ModeBank, impulse_ns: f64) -> Result<f
 pub fn run(args: StrikeArgs) -> Result<()> {
     // Everything a radiation solve could be wasted on is checked first.
     modal_synth::check_sample_rate(args.rate as f64)?;
-    if let Some(f) = args.transfer_max_freq {
-        ensure!(f.is_finite() && f > 0.0, "--transfer-max-freq must be a positive frequency in Hz, got {f}");
-    }
+    super::args::check_transfer_max_freq(args.transfer_max_freq)?;
     if let Some(d) = args.duration {
         ensure!(
             d.is_finite() && d > 0.0 && d <= modal_synth::MAX_DURATION_S,
