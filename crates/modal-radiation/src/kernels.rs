@@ -48,7 +48,7 @@
 use faer::c64;
 
 use crate::geometry::{cross, dot, norm, sub, BoundaryMesh, Panel};
-use crate::quadrature::{on_triangle, TRIANGLE_7};
+use crate::quadrature::{on_triangle, quarters, TRIANGLE_7};
 
 /// A (sub)panel is split while the point is closer than this many of its
 /// diameters to its centroid.
@@ -462,9 +462,7 @@ fn split_and_sum<T: std::ops::AddAssign>(
     out: &mut T,
 ) {
     if split(centroid(t), diam, depth) {
-        let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
-        let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
-        for child in [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]] {
+        for child in quarters(t) {
             split_and_sum(child, 0.25 * area, 0.5 * diam, depth + 1, split, f, out);
         }
         return;

@@ -62,6 +62,15 @@ pub fn on_triangle(b: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k])
 }
 
+/// The four children of triangle `t` split at its edge midpoints (corners
+/// as positions or as barycentric coordinates), the centre child last.
+#[inline]
+pub fn quarters(t: [[f64; 3]; 3]) -> [[[f64; 3]; 3]; 4] {
+    let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+    let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
+    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
+}
+
 /// Strang–Fix 3-point rule at the edge-interior points `(2/3, 1/6, 1/6)`,
 /// exact for polynomials of degree 2, weights summing to 1.
 pub const TRIANGLE_3: [([f64; 3], f64); 3] = [

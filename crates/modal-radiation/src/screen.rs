@@ -51,7 +51,7 @@ use rayon::prelude::*;
 use crate::bem::Air;
 use crate::error::RadiationError;
 use crate::geometry::{cross, dot, norm, sub, BoundaryMesh};
-use crate::quadrature::{on_triangle, TRIANGLE_3, TRIANGLE_7};
+use crate::quadrature::{on_triangle, quarters, TRIANGLE_3, TRIANGLE_7};
 
 /// A pair of panels is near (inner integral in closed form, outer by the
 /// 7-point rule) when their centroids are closer than this many times the
@@ -297,14 +297,6 @@ fn green(k: f64, x: [f64; 3], y: [f64; 3]) -> c64 {
     let r = norm(sub(y, x));
     let (sn, cs) = (k * r).sin_cos();
     c64::new(cs, sn) / (FOUR_PI * r)
-}
-
-/// The four children of a triangle given by its corners' barycentric
-/// coordinates, split at its edge midpoints.
-fn quarters(t: [[f64; 3]; 3]) -> [[[f64; 3]; 3]; 4] {
-    let m = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
-    let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
-    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
 }
 
 /// `(∫_S G(x, ·), ∫_S G(x, ·) λ_j)` for `x` near or on `S`, split as
