@@ -306,8 +306,10 @@ impl PipelineProvider<'_> {
                 // evaluated in SIMD lanes (levels within 0.0001 dB, other bits); v14:
                 // compressed assembly from 2 000 unknowns; v15: each panel the exact mean of
                 // its triangle's interpolated velocity (modal_radiation::velocity); v16: ACA's
-                // right-hand-side parts balanced on a block's first row and column (≤ 0.1 dB).
-                let key = CacheKey::new("modal-radiation-v16")
+                // right-hand-side parts balanced on a block's first row and column (≤ 0.1 dB);
+                // v17: the conventional equation below the interior resonances' bound
+                // (modal_radiation::bem::Formulation::Automatic).
+                let key = CacheKey::new("modal-radiation-v17")
                     .add_str("bank", &key)
                     .add_f64("air_density_kg_m3", opts.air.density_kg_m3)
                     .add_f64("sound_speed_m_s", opts.air.sound_speed_m_s)

@@ -78,6 +78,9 @@ fn disc(args: &[String]) -> Probe {
         let s = solve(&closed, air, f, std::slice::from_ref(&vc), form)?.remove(0);
         println!("closed, {name:<14} (P0)   {}", levels(&s, &closed)?);
     }
+    let s =
+        modal_radiation::continuous::solve_continuous(&closed, air, f, std::slice::from_ref(&vc))?.remove(0);
+    println!("closed, BM, continuous N     {}", levels(&s, &closed)?);
     let jump = solve_screen(&closed, air, f, &[vc])?;
     println!(
         "closed, jump (P1 Galerkin)    {}",

@@ -15,7 +15,12 @@
 //! The CBIE alone is singular at the interior Dirichlet eigenfrequencies
 //! (a sphere at `ka = π`); Burton–Miller solves
 //! `(½ − K − αN) p = −(L + α(½ + K')) q` with `α = i/k`, which has a
-//! unique solution at every `k > 0` because `Im α ≠ 0`.
+//! unique solution at every `k > 0` because `Im α ≠ 0`. But on constant
+//! panels `N` leaves a residue at each centroid that does not fall with the
+//! panels (the pressure's jumps at the edges; [`crate::continuous`]), so
+//! the default ([`Formulation::Automatic`]) solves the CBIE wherever no
+//! interior resonance can be, below 0.8 of the Faber–Krahn bound
+//! `π/R_V` ([`interior_wavenumber_bound`]), and Burton–Miller above.
 //!
 //! Discretisation: piecewise-constant `q` on flat panels; `p` piecewise
 //! constant on the panels or on clusters of panels ([`crate::cluster`]:
@@ -99,12 +104,67 @@ impl Air {
 /// Which boundary integral equation is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Formulation {
-    /// CBIE + (i/k)·HBIE: unique at every frequency (the default).
+    /// The conventional equation below [`CONVENTIONAL_MAX_FRACTION`] of
+    /// the body's lowest interior resonance (its bound,
+    /// [`interior_wavenumber_bound`]), Burton–Miller above (the default;
+    /// [`Formulation::resolved`] says which).
     #[default]
+    Automatic,
+    /// CBIE + (i/k)·HBIE: unique at every frequency. On constant panels its
+    /// hypersingular term leaves a residue that does not fall with the
+    /// panels (docs/radiation.md, "Burton–Miller's hypersingular term on
+    /// constant panels").
     BurtonMiller,
-    /// The CBIE alone: wrong near interior resonances (kept to show why
-    /// the guard is needed).
+    /// The CBIE alone: wrong near interior resonances, converging like the
+    /// panels' area below them.
     Conventional,
+}
+
+/// [`Formulation::Automatic`] takes the conventional equation up to this
+/// fraction of [`interior_wavenumber_bound`]: every interior resonance is
+/// then at least 25 % above the frequency, where the equation is well
+/// conditioned.
+pub const CONVENTIONAL_MAX_FRACTION: f64 = 0.8;
+
+/// A lower bound [1/m] on the wavenumber of the lowest interior Dirichlet
+/// resonance of the body `mesh` encloses, where the conventional equation
+/// fails: by the Faber–Krahn inequality no domain of volume `V` has a
+/// lower first Dirichlet eigenvalue than the ball of that volume,
+/// `k₁ ≥ π / R_V`, `R_V = (3V/4π)^⅓` (exact for a sphere: `ka = π`). Several
+/// bodies: each one's bound is above that of their summed volume. 0 when
+/// the surface encloses no volume (then nothing is below it).
+pub fn interior_wavenumber_bound(mesh: &BoundaryMesh) -> f64 {
+    let volume = mesh.enclosed_volume();
+    if !(volume.is_finite() && volume > 0.0) {
+        return 0.0;
+    }
+    let radius = (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt();
+    std::f64::consts::PI / radius
+}
+
+impl Formulation {
+    /// The equation solved at wavenumber `k` [1/m] on `mesh`:
+    /// [`Formulation::Automatic`] resolved to the conventional equation or
+    /// Burton–Miller, the others as they are.
+    pub fn resolved(self, k: f64, mesh: &BoundaryMesh) -> Formulation {
+        match self {
+            Formulation::Automatic if k <= CONVENTIONAL_MAX_FRACTION * interior_wavenumber_bound(mesh) => {
+                Formulation::Conventional
+            }
+            Formulation::Automatic => Formulation::BurtonMiller,
+            other => other,
+        }
+    }
+}
+
+impl std::fmt::Display for Formulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Formulation::Automatic => "automatic",
+            Formulation::BurtonMiller => "Burton–Miller",
+            Formulation::Conventional => "conventional equation",
+        })
+    }
 }
 
 /// Surface solution of one velocity field at one frequency.
@@ -313,9 +373,9 @@ pub fn solve_on(
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
-    let alpha = match formulation {
-        Formulation::BurtonMiller => c64::new(0.0, 1.0 / k),
+    let alpha = match formulation.resolved(k, mesh) {
         Formulation::Conventional => c64::new(0.0, 0.0),
+        _ => c64::new(0.0, 1.0 / k),
     };
     let q: Vec<Vec<c64>> = velocities.iter().map(|v| v.iter().map(|z| z * iwr).collect()).collect();
     let kern = Kernels::new(k);
@@ -449,7 +509,12 @@ fn gmres_solve(
 /// Solves `A x = b` given `at = Aᵀ` (column-major `n × n`, overwritten by
 /// its LU factors) and `b` row-major `n × nrhs`. `None` when a pivot is
 /// zero or the solution is not finite.
-fn lu_solve_transposed(at: &mut [c64], n: usize, rhs: &mut [c64], nrhs: usize) -> Option<Mat<c64>> {
+pub(crate) fn lu_solve_transposed(
+    at: &mut [c64],
+    n: usize,
+    rhs: &mut [c64],
+    nrhs: usize,
+) -> Option<Mat<c64>> {
     let mut lu = MatMut::from_column_major_slice_mut(at, n, n);
     let p = lu_in_place(lu.as_mut())?;
     let lu_ref: MatRef<'_, c64> = lu.as_ref();

@@ -220,6 +220,13 @@ impl BoundaryMesh {
         self.panels.iter().map(|p| p.area).sum()
     }
 
+    /// Volume the surface encloses [m³], `⅓ ∮ x·n dS` (divergence theorem,
+    /// exact for flat panels): the bodies' solid volume for outward
+    /// panels, a sealed cavity's inward panels subtracting its air.
+    pub fn enclosed_volume(&self) -> f64 {
+        self.panels.iter().map(|p| dot(p.centroid, p.normal) * p.area).sum::<f64>() / 3.0
+    }
+
     /// Area-weighted centroid of the surface [m].
     pub fn surface_centroid(&self) -> [f64; 3] {
         let a = self.area();
@@ -350,6 +357,32 @@ pub(crate) mod tests {
         let (v, t) = modal_mesh::icosphere(subdiv);
         let v = v.iter().map(|p| [0, 1, 2].map(|k| axes[k] * p[k])).collect();
         BoundaryMesh::new(v, &t).unwrap()
+    }
+
+    /// The divergence theorem's volume: an inscribed sphere's just under
+    /// the ball's, two bodies' summed, an inward surface's negative (and
+    /// then no interior resonance bound).
+    #[test]
+    fn enclosed_volume_is_the_solids() {
+        let ball = 4.0 / 3.0 * std::f64::consts::PI * 0.1f64.powi(3);
+        let one = icosphere(0.1, [0.0; 3], 4);
+        let v = one.enclosed_volume();
+        assert!(v < ball && v > 0.99 * ball, "{v} vs {ball}");
+        let (mut vs, mut ts) =
+            (one.vertices.clone(), one.panels.iter().map(|p| p.corners).collect::<Vec<_>>());
+        let shift = vs.len();
+        vs.extend(one.vertices.iter().map(|x| [x[0] + 0.5, x[1], x[2]]));
+        ts.extend(one.panels.iter().map(|p| p.corners.map(|c| c + shift)));
+        let two = BoundaryMesh::new(vs, &ts).unwrap();
+        assert!((two.enclosed_volume() - 2.0 * v).abs() < 1e-12 * v);
+        let inward: Vec<[usize; 3]> =
+            one.panels.iter().map(|p| [p.corners[0], p.corners[2], p.corners[1]]).collect();
+        let inward = BoundaryMesh::new(one.vertices.clone(), &inward).unwrap();
+        assert!((inward.enclosed_volume() + v).abs() < 1e-12 * v);
+        assert_eq!(crate::bem::interior_wavenumber_bound(&inward), 0.0);
+        let bound = crate::bem::interior_wavenumber_bound(&two) * 0.1;
+        let want = std::f64::consts::PI / 2f64.cbrt() * (ball / v).cbrt();
+        assert!((bound / want - 1.0).abs() < 1e-12, "{bound} vs {want}");
     }
 
     #[test]

@@ -9,8 +9,9 @@
 //! with its order chosen to a stated error.
 //!
 //! Method ([`bem`]): exterior Neumann Helmholtz problem, time convention
-//! `e^{−iωt}`, Burton–Miller formulation (no fictitious interior
-//! resonances), constant flat panels with centroid collocation, dense
+//! `e^{−iωt}`, the conventional equation below the body's lowest interior
+//! resonance (its Faber–Krahn bound) and Burton–Miller above (no
+//! fictitious interior resonances), constant flat panels with centroid collocation, dense
 //! complex LU (faer, sequential) for small systems and restarted GMRES
 //! ([`gmres`]) for large ones, rayon row assembly: results are
 //! bit-identical for any thread count.
@@ -25,6 +26,7 @@
 //! - [`precond`]: the block-Jacobi preconditioner of the GMRES solves;
 //! - [`normals`]: smooth-surface node normals fitted to the local surface, never across creases;
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
+//! - [`continuous`]: Burton–Miller with a continuous pressure in its hypersingular term (a dense study: not better at practical sizes; not used by the solves);
 //! - [`screen`]: an open screen's pressure jump by Galerkin (the thin-wall probe; not used by the solves);
 //! - [`walls`]: how much of a surface is a wall thinner than its panels;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
@@ -38,6 +40,7 @@ pub mod assembly;
 mod batch;
 pub mod bem;
 pub mod cluster;
+pub mod continuous;
 mod error;
 pub mod geometry;
 pub mod gmres;

@@ -37,7 +37,8 @@ pub struct RadiationOptions {
     pub group_tolerance: f64,
     /// Relative RMS error of the multipole truncation at twice the body radius.
     pub multipole_tolerance: f64,
-    /// Boundary integral equation (Burton–Miller unless studying).
+    /// Boundary integral equation: the default chooses per frequency
+    /// ([`Formulation::Automatic`]); the others are for studies.
     pub formulation: Formulation,
     /// Frequency-adaptive resolution: clustered pressure unknowns
     /// ([`crate::cluster`]) and, for a quadratic bank, its corner triangles
@@ -67,7 +68,7 @@ impl Default for RadiationOptions {
             air: Air::default(),
             group_tolerance: 1e-3,
             multipole_tolerance: DEFAULT_TOLERANCE,
-            formulation: Formulation::BurtonMiller,
+            formulation: Formulation::Automatic,
             adaptive_resolution: true,
             cluster_kh: DEFAULT_CLUSTER_KH,
             memory_limit_bytes: None,
@@ -153,13 +154,15 @@ pub struct Progress {
     pub fit_s: f64,
     /// How the system was solved (a dense LU after GMRES failed is slow).
     pub solver: SolverPath,
+    /// The equation solved ([`Formulation::resolved`]).
+    pub formulation: Formulation,
 }
 
 impl std::fmt::Display for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s{} [{}], fit {:.2} s",
+            "radiation {}/{}: mode(s) {:?} at {:.1} Hz, {} unknowns on {} panels{}, solve {:.2} s{} [{}; {}], fit {:.2} s",
             self.groups_done,
             self.groups,
             self.modes,
@@ -180,6 +183,7 @@ impl std::fmt::Display for Progress {
                 String::new()
             },
             self.solver,
+            self.formulation,
             self.fit_s
         )
     }
@@ -619,7 +623,8 @@ pub fn radiate_modes_on(
             aggregate: opts.adaptive_resolution,
             memory_limit_bytes: opts.memory_limit_bytes,
         };
-        let (surfaces, solver) = solve_on(&disc, opts.air, f, &fields, opts.formulation)?;
+        let formulation = opts.formulation.resolved(k, mesh);
+        let (surfaces, solver) = solve_on(&disc, opts.air, f, &fields, formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let multipoles = fit(mesh, &surfaces, centre, opts.multipole_tolerance);
@@ -651,6 +656,7 @@ pub fn radiate_modes_on(
             near_bytes: near.bytes(),
             fit_s,
             solver,
+            formulation,
         });
     }
     Ok(out)
