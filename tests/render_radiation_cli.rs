@@ -72,4 +72,8 @@ fn bad_radiation_choice_is_one_clear_error() {
     assert!(run.stderr.contains("transfer") && run.stderr.contains("estimate"), "{}", run.stderr);
     std::fs::write(dir.path().join("s.toml"), BAR).unwrap();
     modal(dir.path(), &["render", "s.toml", "--transfer-max-freq", "0"]).fails_with("--transfer-max-freq");
+    // A negative value gets the same check's words, as in `strike`, not
+    // clap's "unexpected argument".
+    modal(dir.path(), &["render", "s.toml", "--transfer-max-freq", "-5"])
+        .fails_with("--transfer-max-freq must be a positive frequency");
 }

@@ -462,9 +462,9 @@ pub struct RenderArgs {
     /// (said on stderr). The default, 6 kHz, solves the modes the estimate
     /// gets most wrong (low `ka`) at a cost of seconds per asset (the demo:
     /// ≈ 15 s for all three); `--transfer-max-freq 24000` solves every
-    /// playable mode (the demo's thin bowl: ≈ 3–4 minutes on 2 cores;
-    /// BENCHMARKS.md, "Cost today").
-    #[arg(long, value_name = "HZ")]
+    /// playable mode (the demo's three: ≈ 2 minutes on 2 cores, most of it
+    /// the thin bowl; BENCHMARKS.md, "Cost today").
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
     pub transfer_max_freq: Option<f64>,
     /// Accepted for old scripts: solving the transfer is now the default.
     #[arg(long, hide = true)]
