@@ -19,8 +19,8 @@
 //! panels `N` leaves a residue at each centroid that does not fall with the
 //! panels (the pressure's jumps at the edges; [`crate::continuous`]), so
 //! the default ([`Formulation::Automatic`]) solves the CBIE wherever no
-//! interior resonance can be, below 0.8 of the Faber–Krahn bound
-//! `π/R_V` ([`interior_wavenumber_bound`]), and Burton–Miller above.
+//! interior resonance can be, below 0.8 of a rigorous bound on the lowest
+//! one ([`interior_wavenumber_bound`]), and Burton–Miller above.
 //!
 //! Discretisation: piecewise-constant `q` on flat panels; `p` piecewise
 //! constant on the panels or on clusters of panels ([`crate::cluster`]:
@@ -54,6 +54,7 @@ use crate::kernels::{CoupledKernels, Kernels};
 use crate::near::NearField;
 use crate::precond::BlockJacobi;
 use crate::quadrature::{on_triangle, TRIANGLE_7};
+pub use crate::resonance::interior_wavenumber_bound;
 
 /// Properties of the air.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,26 +122,11 @@ pub enum Formulation {
 }
 
 /// [`Formulation::Automatic`] takes the conventional equation up to this
-/// fraction of [`interior_wavenumber_bound`]: every interior resonance is
+/// fraction of [`interior_wavenumber_bound`] (the larger of the
+/// Faber–Krahn and bounding-box bounds, [`crate::resonance`]): every interior resonance is
 /// then at least 25 % above the frequency, where the equation is well
 /// conditioned.
 pub const CONVENTIONAL_MAX_FRACTION: f64 = 0.8;
-
-/// A lower bound [1/m] on the wavenumber of the lowest interior Dirichlet
-/// resonance of the body `mesh` encloses, where the conventional equation
-/// fails: by the Faber–Krahn inequality no domain of volume `V` has a
-/// lower first Dirichlet eigenvalue than the ball of that volume,
-/// `k₁ ≥ π / R_V`, `R_V = (3V/4π)^⅓` (exact for a sphere: `ka = π`). Several
-/// bodies: each one's bound is above that of their summed volume. 0 when
-/// the surface encloses no volume (then nothing is below it).
-pub fn interior_wavenumber_bound(mesh: &BoundaryMesh) -> f64 {
-    let volume = mesh.enclosed_volume();
-    if !(volume.is_finite() && volume > 0.0) {
-        return 0.0;
-    }
-    let radius = (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt();
-    std::f64::consts::PI / radius
-}
 
 impl Formulation {
     /// The equation solved at wavenumber `k` [1/m] on `mesh`:

@@ -10,7 +10,7 @@
 //!
 //! Method ([`bem`]): exterior Neumann Helmholtz problem, time convention
 //! `e^{−iωt}`, the conventional equation below the body's lowest interior
-//! resonance (its Faber–Krahn bound) and Burton–Miller above (no
+//! resonance (a rigorous bound on it, [`resonance`]) and Burton–Miller above (no
 //! fictitious interior resonances), constant flat panels with centroid collocation, dense
 //! complex LU (faer, sequential) for small systems and restarted GMRES
 //! ([`gmres`]) for large ones, rayon row assembly: results are
@@ -28,6 +28,7 @@
 //! - [`mfs`]: equivalent sources, the independent method of the cross-checks;
 //! - [`continuous`]: Burton–Miller with a continuous pressure in its hypersingular term (a dense study: not better at practical sizes; not used by the solves);
 //! - [`screen`]: an open screen's pressure jump by Galerkin (the thin-wall probe; not used by the solves);
+//! - [`resonance`]: a lower bound on the body's lowest interior resonance (where the conventional equation is safe);
 //! - [`walls`]: how much of a surface is a wall thinner than its panels;
 //! - [`special`]: spherical Hankel functions and spherical harmonics;
 //!
@@ -55,6 +56,7 @@ pub mod normals;
 pub mod precond;
 pub mod quadrature;
 pub mod refine;
+pub mod resonance;
 pub mod screen;
 mod sincos;
 pub mod special;
