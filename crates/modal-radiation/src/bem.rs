@@ -332,6 +332,27 @@ impl std::fmt::Display for SolverPath {
     }
 }
 
+/// The checks every surface solve makes of its inputs: the air, a finite
+/// positive frequency, and per field one finite normal velocity per panel
+/// (`panels` of them).
+pub(crate) fn check_problem(
+    air: Air,
+    frequency_hz: f64,
+    panels: usize,
+    velocities: &[Vec<c64>],
+) -> Result<(), RadiationError> {
+    air.validate()?;
+    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+        return Err(RadiationError::BadFrequency(frequency_hz));
+    }
+    for (f, v) in velocities.iter().enumerate() {
+        if v.len() != panels || v.iter().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
+            return Err(RadiationError::BadVelocity { field: f, got: v.len(), expected: panels });
+        }
+    }
+    Ok(())
+}
+
 /// [`solve_clustered`] on a prepared [`Discretization`], also saying how
 /// the system was solved.
 pub fn solve_on(
@@ -345,16 +366,7 @@ pub fn solve_on(
     if clusters.of_panel.len() != mesh.len() || clusters.of_panel.iter().any(|&c| c >= clusters.len()) {
         return Err(RadiationError::Bank("the clusters do not partition the panels".into()));
     }
-    air.validate()?;
-    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
-        return Err(RadiationError::BadFrequency(frequency_hz));
-    }
-    let n = mesh.len();
-    for (f, v) in velocities.iter().enumerate() {
-        if v.len() != n || v.iter().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
-            return Err(RadiationError::BadVelocity { field: f, got: v.len(), expected: n });
-        }
-    }
+    check_problem(air, frequency_hz, mesh.len(), velocities)?;
     let omega = 2.0 * std::f64::consts::PI * frequency_hz;
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);

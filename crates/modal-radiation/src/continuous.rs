@@ -227,16 +227,8 @@ pub fn solve_continuous(
     frequency_hz: f64,
     velocities: &[Vec<c64>],
 ) -> Result<Vec<SurfaceField>, RadiationError> {
-    air.validate()?;
-    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
-        return Err(RadiationError::BadFrequency(frequency_hz));
-    }
+    crate::bem::check_problem(air, frequency_hz, mesh.len(), velocities)?;
     let n = mesh.len();
-    for (f, v) in velocities.iter().enumerate() {
-        if v.len() != n || v.iter().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
-            return Err(RadiationError::BadVelocity { field: f, got: v.len(), expected: n });
-        }
-    }
     let omega = std::f64::consts::TAU * frequency_hz;
     let k = omega / air.sound_speed_m_s;
     let alpha = c64::new(0.0, 1.0 / k);

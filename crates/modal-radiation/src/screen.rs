@@ -121,15 +121,7 @@ pub fn solve_screen(
     frequency_hz: f64,
     velocities: &[Vec<c64>],
 ) -> Result<ScreenJump, RadiationError> {
-    air.validate()?;
-    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
-        return Err(RadiationError::BadFrequency(frequency_hz));
-    }
-    for (f, v) in velocities.iter().enumerate() {
-        if v.len() != mesh.len() || v.iter().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
-            return Err(RadiationError::BadVelocity { field: f, got: v.len(), expected: mesh.len() });
-        }
-    }
+    crate::bem::check_problem(air, frequency_hz, mesh.len(), velocities)?;
     let unknown = interior_nodes(mesh);
     let n = unknown.iter().filter(|u| u.is_some()).count();
     if n > MAX_SCREEN_UNKNOWNS {
