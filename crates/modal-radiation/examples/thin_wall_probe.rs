@@ -7,7 +7,9 @@
 //!   translation, the default), as an open screen of no thickness
 //!   ([`modal_radiation::screen`]) and as the closed disc THICKNESS_M thick by
 //!   the production collocation (Burton–Miller and the conventional
-//!   equation) and by the screen's Galerkin scheme on the closed surface
+//!   equation), by Burton–Miller with a continuous pressure in its
+//!   hypersingular term ([`modal_radiation::continuous`], a study) and by
+//!   the screen's Galerkin scheme on the closed surface
 //!   (whose jump's double layer is then the exterior field): `|p|` at
 //!   0.4 m from the centre, 0, 0.6 and 1.2 rad from the axis, in the plane
 //!   `φ = 0`. `tools/screen_ref.py` solves the same meshes with bempp-cl.
