@@ -134,9 +134,16 @@ impl Formulation {
     /// Burton–Miller, the others as they are.
     pub fn resolved(self, k: f64, mesh: &BoundaryMesh) -> Formulation {
         match self {
-            Formulation::Automatic if k <= CONVENTIONAL_MAX_FRACTION * interior_wavenumber_bound(mesh) => {
-                Formulation::Conventional
-            }
+            Formulation::Automatic => self.resolved_below(k, interior_wavenumber_bound(mesh)),
+            other => other,
+        }
+    }
+
+    /// [`Formulation::resolved`] given the mesh's
+    /// [`interior_wavenumber_bound`] `bound` [1/m] (computed once per mesh).
+    pub fn resolved_below(self, k: f64, bound: f64) -> Formulation {
+        match self {
+            Formulation::Automatic if k <= CONVENTIONAL_MAX_FRACTION * bound => Formulation::Conventional,
             Formulation::Automatic => Formulation::BurtonMiller,
             other => other,
         }

@@ -413,6 +413,9 @@ struct Level {
     near: std::sync::OnceLock<NearField>,
     /// Longest panel edge [m].
     h: f64,
+    /// [`crate::bem::interior_wavenumber_bound`] of the mesh [1/m]: where
+    /// [`Formulation::Automatic`] changes equation.
+    resonance_bound: f64,
     /// Per panel, where its velocity comes from ([`crate::velocity`]).
     sources: Vec<PanelSource>,
     /// Per panel, [`PanelSource::weights`].
@@ -424,6 +427,7 @@ impl Level {
         debug_assert_eq!(mesh.len(), sources.len());
         Level {
             h: mesh.panels.iter().map(|p| p.diameter).fold(0.0, f64::max),
+            resonance_bound: crate::bem::interior_wavenumber_bound(&mesh),
             adjacency: Adjacency::new(&mesh),
             near: std::sync::OnceLock::new(),
             mesh: Arc::new(mesh),
@@ -623,7 +627,7 @@ pub fn radiate_modes_on(
             aggregate: opts.adaptive_resolution,
             memory_limit_bytes: opts.memory_limit_bytes,
         };
-        let formulation = opts.formulation.resolved(k, mesh);
+        let formulation = opts.formulation.resolved_below(k, plan.level.resonance_bound);
         let (surfaces, solver) = solve_on(&disc, opts.air, f, &fields, formulation)?;
         let solve_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
