@@ -4,19 +4,18 @@
 //!
 //! The conventional equation fails at the interior Dirichlet resonances of
 //! the solid `Ω` the surface encloses: `−Δu = k²u` in `Ω`, `u = 0` on its
-//! surface. Two rigorous lower bounds on the first, `k₁`, each from a
+//! surface. Three rigorous lower bounds on the first, `k₁`, each from a
 //! classical inequality on the first eigenvalue `λ₁ = k₁²`:
 //!
 //! - **Faber–Krahn**: no domain of volume `V` has a lower `λ₁` than the ball
 //!   of that volume, so `k₁ ≥ π/R_V`, `R_V = (3V/4π)^⅓`. Exact for a sphere
-//!   (`ka = π`); the best bound for round bodies (bowls, bells, balls).
+//!   (`ka = π`); the best bound for round solid bodies.
 //! - **Domain monotonicity**: `Ω ⊂ B` implies `λ₁(Ω) ≥ λ₁(B)`, and a box
 //!   `a × b × c` has `λ₁ = π²(1/a² + 1/b² + 1/c²)`. Any box holding every
 //!   vertex holds the solid; tried in the bank's axes and in the principal
 //!   axes of the vertices. Exact for a box (a bar: 16.7 kHz for the demo's,
 //!   where Faber–Krahn gives 6.6 kHz); a plate `t` thick is bounded by
 //!   `π/t` (a 2 mm disc: 86 kHz).
-//!
 //! - **A spherical shell** `r₁ ≤ |x − c| ≤ r₂` holding the solid (domain
 //!   monotonicity again): its first eigenfunction is radial, `sin(π(r −
 //!   r₁)/t)/r`, so `λ₁ = (π/t)²`, `t = r₂ − r₁`. `c` is the centre of the
