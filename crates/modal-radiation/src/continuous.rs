@@ -235,10 +235,7 @@ pub fn solve_continuous(
     let iwr = c64::new(0.0, omega * air.density_kg_m3);
     let nrhs = velocities.len();
     let kern = Kernels::new(k);
-    let gl = {
-        let (x, w) = crate::quadrature::gauss_legendre(MOMENT_POINTS);
-        (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
-    };
+    let gl = crate::quadrature::gauss_legendre_unit(MOMENT_POINTS);
     let means = vertex_means(mesh);
     // Row i of A (row-major) and its right-hand sides.
     let rows: Vec<(Vec<c64>, Vec<c64>)> = (0..n)
@@ -319,10 +316,7 @@ mod tests {
     fn hat_integrals_sum_to_the_constant_panels() {
         let mesh = ellipsoid([0.1, 0.07, 0.05], 2);
         let kern = Kernels::new(40.0);
-        let gl = {
-            let (x, w) = crate::quadrature::gauss_legendre(MOMENT_POINTS);
-            (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
-        };
+        let gl = crate::quadrature::gauss_legendre_unit(MOMENT_POINTS);
         let p0 = &mesh.panels[0];
         for (j, pj) in mesh.panels.iter().enumerate().take(40) {
             let (sum, whole) = if j == 0 {
@@ -348,10 +342,7 @@ mod tests {
         let mesh = BoundaryMesh::new(t.to_vec(), &[[0, 1, 2]]).unwrap();
         let p = &mesh.panels[0];
         let k = 120.0;
-        let gl = {
-            let (x, w) = crate::quadrature::gauss_legendre(MOMENT_POINTS);
-            (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
-        };
+        let gl = crate::quadrature::gauss_legendre_unit(MOMENT_POINTS);
         let got = self_first_moment(k, &gl, &mesh, p);
         // Midpoint rule on a 1 500² grid of the bounding box, points outside
         // the panel or within ε of x dropped.
@@ -412,10 +403,7 @@ mod convergence {
             let factor = c64::new(0.0, k * k * k * a * a) * djl * spherical_hankel_derivative(l, ka)[l];
             let p: Vec<f64> = mesh.panels.iter().map(|q| pl(q.centroid[2] / norm(q.centroid))).collect();
             let kern = Kernels::new(k);
-            let gl = {
-                let (x, w) = crate::quadrature::gauss_legendre(MOMENT_POINTS);
-                (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
-            };
+            let gl = crate::quadrature::gauss_legendre_unit(MOMENT_POINTS);
             let means = vertex_means(&mesh);
             let vertex: Vec<f64> = means.iter().map(|m| m.iter().map(|(j, w)| p[*j] * w).sum()).collect();
             let exact_vertex: Vec<f64> = mesh.vertices.iter().map(|v| pl(v[2] / norm(*v))).collect();

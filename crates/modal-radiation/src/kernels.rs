@@ -104,8 +104,7 @@ pub struct Kernels {
 impl Kernels {
     /// Kernels at wavenumber `k` [1/m].
     pub fn new(k: f64) -> Kernels {
-        let (x, w) = crate::quadrature::gauss_legendre(SELF_POINTS);
-        Kernels { k, gl: (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect()) }
+        Kernels { k, gl: crate::quadrature::gauss_legendre_unit(SELF_POINTS) }
     }
 
     /// Wavenumber [1/m].

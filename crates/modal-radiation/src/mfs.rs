@@ -65,10 +65,8 @@ pub fn fit(
     vn: &dyn Fn(usize, [f64; 3]) -> c64,
     retreat: f64,
 ) -> Result<EquivalentSources, RadiationError> {
-    air.validate()?;
-    if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
-        return Err(RadiationError::BadFrequency(frequency_hz));
-    }
+    // The air and the frequency; the velocity is a function here, no list.
+    crate::bem::check_problem(air, frequency_hz, mesh.len(), &[])?;
     let omega = 2.0 * std::f64::consts::PI * frequency_hz;
     let k = omega / air.sound_speed_m_s;
     let iwr = c64::new(0.0, omega * air.density_kg_m3);

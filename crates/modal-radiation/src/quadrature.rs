@@ -39,6 +39,14 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (nodes, weights)
 }
 
+/// Gauss–Legendre nodes and weights mapped to `[0, 1]` (weights summing
+/// to 1): the rule of the singular integrals along a panel edge and along
+/// a ray.
+pub fn gauss_legendre_unit(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let (x, w) = gauss_legendre(n);
+    (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
+}
+
 /// `P_n(x)` and `P_n'(x)` by the three-term recurrence.
 fn legendre_and_derivative(n: usize, x: f64) -> (f64, f64) {
     let (mut p0, mut p1) = (1.0, x);
