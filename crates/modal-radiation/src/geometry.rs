@@ -470,16 +470,21 @@ pub(crate) mod tests {
         assert!(face > 20 && other > 100, "regions sampled: {face} face, {other} edge or corner");
     }
 
-    /// A box-like closed mesh: the block [0, 0.08] × [0, 0.05] × [0, 0.04]
-    /// (the 8 × 5 × 4 cm wooden block), each face split into two triangles.
-    fn block() -> BoundaryMesh {
-        let s = [0.08, 0.05, 0.04];
+    /// The box `[0, s₀] × [0, s₁] × [0, s₂]` as 12 outward triangles, its
+    /// corners moved by `place` (a rotation, say).
+    pub fn box_surface(sides: [f64; 3], place: impl Fn([f64; 3]) -> [f64; 3]) -> BoundaryMesh {
         let v: Vec<[f64; 3]> =
-            (0..8).map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { s[k] } else { 0.0 })).collect();
+            (0..8).map(|i| place([0, 1, 2].map(|k| if i >> k & 1 == 1 { sides[k] } else { 0.0 }))).collect();
         // Corner index bits: x = 1, y = 2, z = 4; outward counter-clockwise.
         let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         let t: Vec<[usize; 3]> = quads.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
         BoundaryMesh::new(v, &t).unwrap()
+    }
+
+    /// A box-like closed mesh: the block [0, 0.08] × [0, 0.05] × [0, 0.04]
+    /// (the 8 × 5 × 4 cm wooden block), each face split into two triangles.
+    fn block() -> BoundaryMesh {
+        box_surface([0.08, 0.05, 0.04], |x| x)
     }
 
     /// Points on a face centre, an edge, a corner, and just inside and just

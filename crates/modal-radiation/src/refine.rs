@@ -115,21 +115,7 @@ mod tests {
 
     /// A closed box `[0, 2] × [0, 1] × [0, 0.1]` of 12 triangles.
     fn slab() -> BoundaryMesh {
-        let (x, y, z) = (2.0, 1.0, 0.1);
-        let v = vec![
-            [0.0, 0.0, 0.0],
-            [x, 0.0, 0.0],
-            [x, y, 0.0],
-            [0.0, y, 0.0],
-            [0.0, 0.0, z],
-            [x, 0.0, z],
-            [x, y, z],
-            [0.0, y, z],
-        ];
-        let quads = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
-        let tris: Vec<[usize; 3]> =
-            quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-        BoundaryMesh::new(v, &tris).unwrap()
+        crate::geometry::tests::box_surface([2.0, 1.0, 0.1], |x| x)
     }
 
     /// Every edge of a box is a crease and its face diagonals are not; each

@@ -112,23 +112,16 @@ fn principal_axes(points: &[[f64; 3]]) -> Option<[[f64; 3]; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::icosphere;
+    use crate::geometry::tests::{box_surface, icosphere};
 
     /// A box `sides` [m] turned about two axes, as 12 outward triangles.
     fn turned_box(sides: [f64; 3]) -> BoundaryMesh {
         let (c, s) = (0.6f64.cos(), 0.6f64.sin());
         let (c2, s2) = (0.3f64.cos(), 0.3f64.sin());
-        let v: Vec<[f64; 3]> = (0..8)
-            .map(|i| {
-                let p = [0, 1, 2].map(|k| if i >> k & 1 == 1 { 0.5 * sides[k] } else { -0.5 * sides[k] });
-                let q = [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]];
-                [q[0], c2 * q[1] - s2 * q[2], s2 * q[1] + c2 * q[2]]
-            })
-            .collect();
-        let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let tris: Vec<[usize; 3]> =
-            faces.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
-        BoundaryMesh::new(v, &tris).unwrap()
+        box_surface(sides, |p| {
+            let q = [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]];
+            [q[0], c2 * q[1] - s2 * q[2], s2 * q[1] + c2 * q[2]]
+        })
     }
 
     #[test]
